@@ -1,0 +1,23 @@
+# Dependencies of obsgroup, shared by the build tree and by obsgroupConfig.cmake
+# so that find_package(obsgroup) finds exactly what the library was built with.
+
+# PCL 1.13's config probes VTK (and OpenNI, libusb) as optional extras and then
+# fails on a C++-only project (VTK::mpi -> MPI::MPI_C not found). obsgroup
+# needs none of them; disabling the look-up also keeps Qt/VTK flags out of
+# our targets.
+set(CMAKE_DISABLE_FIND_PACKAGE_VTK TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_OpenNI TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_OpenNI2 TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_libusb TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_ensenso TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_davidSDK TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_DSSDK TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_RSSDK TRUE)
+set(CMAKE_DISABLE_FIND_PACKAGE_RSSDK2 TRUE)
+
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(PCL 1.10 REQUIRED COMPONENTS common kdtree search filters)
+find_package(OpenMP REQUIRED)
+find_package(Spectra 1.0 REQUIRED CONFIG)
+
+set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters)

@@ -1,0 +1,179 @@
+#include "floor_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace obsgroup::sim {
+
+void FloorPlan::addBox(double x0, double y0, double x1, double y1) {
+  const Eigen::Vector2d p00(x0, y0), p10(x1, y0), p11(x1, y1), p01(x0, y1);
+  segments_.push_back({p00, p10});
+  segments_.push_back({p10, p11});
+  segments_.push_back({p11, p01});
+  segments_.push_back({p01, p00});
+}
+
+namespace {
+/// The solid pieces of [from, to] once the openings are cut out.
+std::vector<std::pair<double, double>> solidPieces(double from, double to,
+                                                   std::vector<std::pair<double, double>> openings) {
+  std::sort(openings.begin(), openings.end());
+  std::vector<std::pair<double, double>> pieces;
+  double start = from;
+  for (const auto& [a, b] : openings) {
+    if (a > start) pieces.emplace_back(start, a);
+    start = std::max(start, b);
+  }
+  if (to > start) pieces.emplace_back(start, to);
+  return pieces;
+}
+}  // namespace
+
+void FloorPlan::addWallX(double y, double from, double to, std::vector<std::pair<double, double>> openings,
+                         double thickness) {
+  for (const auto& [a, b] : solidPieces(from, to, std::move(openings)))
+    addBox(a, y - thickness / 2, b, y + thickness / 2);
+}
+
+void FloorPlan::addWallY(double x, double from, double to, std::vector<std::pair<double, double>> openings,
+                         double thickness) {
+  for (const auto& [a, b] : solidPieces(from, to, std::move(openings)))
+    addBox(x - thickness / 2, a, x + thickness / 2, b);
+}
+
+void FloorPlan::addRoom(std::string name, double x0, double y0, double x1, double y1) {
+  rooms_.push_back({x0, y0, x1, y1});
+  room_names_.push_back(std::move(name));
+}
+
+std::vector<double> FloorPlan::scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed) const {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, laser.range_noise > 0 ? laser.range_noise : 1.0);
+  std::vector<double> ranges(laser.beams, laser.max_range);
+  const Eigen::Vector2d origin(pose.x, pose.y);
+  const double step = laser.beams > 1 ? laser.field_of_view / (laser.beams - 1) : 0.0;
+  for (int k = 0; k < laser.beams; ++k) {
+    const double angle = pose.yaw - laser.field_of_view / 2 + k * step;
+    const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
+    double best = std::numeric_limits<double>::infinity();
+    for (const Segment& s : segments_) {
+      // origin + t dir = a + u (b - a), t > 0, u in [0, 1]
+      const Eigen::Vector2d e = s.b - s.a;
+      const double den = dir.x() * (-e.y()) - dir.y() * (-e.x());
+      if (std::abs(den) < 1e-12) continue;
+      const Eigen::Vector2d r = s.a - origin;
+      const double t = (r.x() * (-e.y()) - r.y() * (-e.x())) / den;
+      const double u = (dir.x() * r.y() - dir.y() * r.x()) / den;
+      if (t > 1e-9 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+    }
+    const double n = laser.range_noise > 0 ? noise(rng) : 0.0;
+    if (best < laser.max_range) ranges[k] = std::min(best + n, laser.max_range);
+  }
+  return ranges;
+}
+
+int FloorPlan::roomAt(double x, double y) const {
+  for (std::size_t r = 0; r < rooms_.size(); ++r)
+    if (x >= rooms_[r].x0 && x <= rooms_[r].x1 && y >= rooms_[r].y0 && y <= rooms_[r].y1)
+      return static_cast<int>(r);
+  return -1;
+}
+
+std::vector<Eigen::Vector2d> scanToPoints(const std::vector<double>& ranges, const LaserModel& laser) {
+  std::vector<Eigen::Vector2d> points;
+  const double step = ranges.size() > 1 ? laser.field_of_view / (ranges.size() - 1) : 0.0;
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
+    if (!(ranges[k] < laser.max_range)) continue;
+    const double angle = -laser.field_of_view / 2 + k * step;
+    points.emplace_back(ranges[k] * std::cos(angle), ranges[k] * std::sin(angle));
+  }
+  return points;
+}
+
+std::vector<Pose2D> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double spacing) {
+  std::vector<Pose2D> poses;
+  double carried = 0.0;  // distance already travelled past the last pose
+  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) {
+    const Eigen::Vector2d d = waypoints[w + 1] - waypoints[w];
+    const double length = d.norm();
+    if (length == 0.0) continue;
+    const double yaw = std::atan2(d.y(), d.x());
+    for (double s = (poses.empty() ? 0.0 : spacing - carried); s < length; s += spacing) {
+      const Eigen::Vector2d p = waypoints[w] + d * (s / length);
+      poses.push_back({p.x(), p.y(), yaw});
+      carried = length - s;
+    }
+  }
+  return poses;
+}
+
+FloorPlan threeRooms() {
+  FloorPlan plan;
+  plan.addWallX(0.0, -0.1, 18.1);
+  plan.addWallX(5.0, -0.1, 18.1);
+  plan.addWallY(0.0, 0.0, 5.0);
+  plan.addWallY(18.0, 0.0, 5.0);
+  plan.addWallY(6.0, 0.0, 5.0, {{2.0, 3.0}});
+  plan.addWallY(12.0, 0.0, 5.0, {{2.0, 3.0}});
+  // Furniture, so that the rooms do not look alike.
+  plan.addBox(1.0, 3.8, 2.5, 4.6);
+  plan.addBox(9.0, 0.4, 10.5, 1.0);
+  plan.addBox(15.5, 3.0, 16.5, 4.0);
+  plan.addRoom("west", 0.0, 0.0, 6.0, 5.0);
+  plan.addRoom("middle", 6.0, 0.0, 12.0, 5.0);
+  plan.addRoom("east", 12.0, 0.0, 18.0, 5.0);
+  return plan;
+}
+
+std::vector<Pose2D> threeRoomsPoses(int per_room) {
+  std::vector<Pose2D> poses;
+  for (int room = 0; room < 3; ++room) {
+    for (int k = 0; k < per_room; ++k) {
+      const double t = (k + 0.5) / per_room;
+      poses.push_back({room * 6.0 + 1.5 + 3.0 * t, 1.5 + 2.0 * std::sin(6.28318530718 * t) * 0.5 + 1.0 * t,
+                       6.28318530718 * t});
+    }
+  }
+  return poses;
+}
+
+FloorPlan office() {
+  // Corridor y in [0, 2.5], x in [0, 32]; rooms above it, 8 m wide, 6 m deep.
+  FloorPlan plan;
+  plan.addWallX(0.0, -0.1, 32.1);
+  plan.addWallY(0.0, 0.0, 8.5);
+  plan.addWallY(32.0, 0.0, 8.5);
+  plan.addWallX(8.5, -0.1, 32.1);
+  std::vector<std::pair<double, double>> doors;
+  for (int r = 0; r < 4; ++r) doors.emplace_back(r * 8.0 + 3.5, r * 8.0 + 4.5);
+  plan.addWallX(2.5, 0.0, 32.0, doors);
+  for (int r = 1; r < 4; ++r) plan.addWallY(r * 8.0, 2.5, 8.5);
+  // A little furniture per room and a pillar in the corridor.
+  plan.addBox(1.0, 6.5, 3.0, 7.5);
+  plan.addBox(13.0, 4.0, 14.0, 5.5);
+  plan.addBox(18.0, 6.8, 21.0, 7.6);
+  plan.addBox(29.0, 3.5, 31.0, 4.5);
+  plan.addBox(15.8, 0.2, 16.2, 0.6);
+  plan.addRoom("corridor", 0.0, 0.0, 32.0, 2.5);
+  for (int r = 0; r < 4; ++r) plan.addRoom("room " + std::to_string(r + 1), r * 8.0, 2.5, r * 8.0 + 8.0, 8.5);
+  return plan;
+}
+
+std::vector<Pose2D> officeRoute(int count) {
+  std::vector<Eigen::Vector2d> waypoints{{1.0, 1.25}};
+  for (int r = 0; r < 4; ++r) {
+    const double door = r * 8.0 + 4.0;
+    waypoints.insert(waypoints.end(), {{door, 1.25}, {door, 4.0}, {door - 2.5, 5.5}, {door, 7.3},
+                                        {door + 2.5, 5.5}, {door, 4.0}, {door, 1.25}});
+  }
+  waypoints.emplace_back(31.0, 1.25);
+  double length = 0.0;
+  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
+  std::vector<Pose2D> poses = samplePath(waypoints, length / count);
+  poses.resize(std::min<std::size_t>(poses.size(), count));
+  return poses;
+}
+
+}  // namespace obsgroup::sim

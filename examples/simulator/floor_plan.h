@@ -1,0 +1,79 @@
+#pragma once
+/// \file
+/// A small 2D scan simulator: walls are solid boxes in a floor plan and a
+/// laser casts rays against them. Used by the examples, tests and benchmarks
+/// to make maps whose true rooms are known. Eigen only, no PCL.
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace obsgroup::sim {
+
+struct Pose2D {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+};
+
+struct LaserModel {
+  int beams = 361;
+  double field_of_view = 3.14159265358979323846;  ///< centred ahead, counter-clockwise
+  double max_range = 30.0;                         ///< no return at or beyond
+  double range_noise = 0.0;                        ///< Gaussian sigma, metres
+};
+
+class FloorPlan {
+ public:
+  /// A solid axis-aligned box (a wall segment, a pillar, a cupboard).
+  void addBox(double x0, double y0, double x1, double y1);
+  /// A wall of the given thickness along x (horizontal) or y (vertical) from
+  /// `from` to `to`, with openings given as (start, end) coordinates along it.
+  void addWallX(double y, double from, double to, std::vector<std::pair<double, double>> openings = {},
+                double thickness = 0.2);
+  void addWallY(double x, double from, double to, std::vector<std::pair<double, double>> openings = {},
+                double thickness = 0.2);
+  /// A named room, used only as ground truth (which room a pose is in).
+  void addRoom(std::string name, double x0, double y0, double x1, double y1);
+
+  /// Ranges of one scan (max_range where no wall is hit), beam k at angle
+  /// yaw - fov/2 + k * fov/(beams-1). Noise comes from `seed`.
+  std::vector<double> scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed = 0) const;
+
+  /// Index of the room containing (x, y), or -1.
+  int roomAt(double x, double y) const;
+  const std::vector<std::string>& roomNames() const { return room_names_; }
+
+ private:
+  struct Segment {
+    Eigen::Vector2d a, b;
+  };
+  struct Room {
+    double x0, y0, x1, y1;
+  };
+  std::vector<Segment> segments_;
+  std::vector<Room> rooms_;
+  std::vector<std::string> room_names_;
+};
+
+/// Points of a scan in the sensor frame (x ahead, y left); beams with no
+/// return give no point.
+std::vector<Eigen::Vector2d> scanToPoints(const std::vector<double>& ranges, const LaserModel& laser);
+
+/// Poses every `spacing` metres along a polyline, heading along the path.
+std::vector<Pose2D> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double spacing);
+
+/// Three 6 x 5 m rooms in a row joined by 1 m doors (the situation of the
+/// paper's Fig. 3).
+FloorPlan threeRooms();
+/// Scans taken inside each of the three rooms, `per_room` per room, facing
+/// every direction.
+std::vector<Pose2D> threeRoomsPoses(int per_room = 5);
+
+/// An office: a 32 m corridor with four rooms along it (the setting of the
+/// paper's Fig. 5).
+FloorPlan office();
+/// A route along the corridor that visits every room, `count` poses.
+std::vector<Pose2D> officeRoute(int count = 77);
+
+}  // namespace obsgroup::sim

@@ -1,0 +1,37 @@
+#pragma once
+
+#include "obsgroup/observation_grouping.h"
+
+#include <stdexcept>
+
+namespace obsgroup {
+
+template <typename PointT>
+void ObservationGrouping<PointT>::addObservation(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose) {
+  if (!cloud) throw std::invalid_argument("ObservationGrouping::addObservation: null cloud");
+  observations_.push_back({cloud, pose});
+}
+
+template <typename PointT>
+void ObservationGrouping<PointT>::addObservation(const PointCloudConstPtr& cloud) {
+  if (!cloud) throw std::invalid_argument("ObservationGrouping::addObservation: null cloud");
+  addObservation(cloud, poseFromSensorOrigin(*cloud));
+}
+
+template <typename PointT>
+void ObservationGrouping<PointT>::clear() {
+  observations_.clear();
+  overlap_result_ = OverlapResult{};
+  W_ = WeightMatrix{};
+}
+
+template <typename PointT>
+Partition ObservationGrouping<PointT>::compute() {
+  overlap_result_ = overlap_.compute(observations_);
+  W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, diagonal_);
+  return recursivePartition(W_, options_);
+}
+
+}  // namespace obsgroup
+
+#define OBSGROUP_INSTANTIATE_ObservationGrouping(T) template class obsgroup::ObservationGrouping<T>;

@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// An observation of the paper's eq. (14): the sensed data o_i (a PCL cloud in
+/// the sensor frame) and the pose p_i it was taken from.
+
+#include <pcl/point_cloud.h>
+
+#include <Eigen/Geometry>
+
+namespace obsgroup {
+
+template <typename PointT>
+struct Observation {
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+
+  /// Points in the sensor frame: a 2D scan (z = 0) or a 3D cloud.
+  PointCloudConstPtr cloud;
+  /// Pose of the sensor frame in the common (world) frame.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+
+/// A planar pose (x, y, heading yaw in radians) as an isometry about z.
+inline Eigen::Isometry3d pose2D(double x, double y, double yaw) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << x, y, 0.0;
+  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return pose;
+}
+
+/// The pose a PCD file stores in its VIEWPOINT field, read back by PCL into
+/// the cloud's sensor_origin_ and sensor_orientation_.
+template <typename PointT>
+Eigen::Isometry3d poseFromSensorOrigin(const pcl::PointCloud<PointT>& cloud) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = cloud.sensor_origin_.template head<3>().template cast<double>();
+  pose.linear() = cloud.sensor_orientation_.template cast<double>().normalized().toRotationMatrix();
+  return pose;
+}
+
+}  // namespace obsgroup

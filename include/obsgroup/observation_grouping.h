@@ -1,0 +1,95 @@
+#pragma once
+/// \file
+/// ObservationGrouping: the whole method of the paper behind one PCL-style
+/// class. Observations in, groups (future local maps) out.
+
+#include "obsgroup/graph/observation_graph.h"
+#include "obsgroup/observation.h"
+#include "obsgroup/overlap/sensed_space_overlap.h"
+#include "obsgroup/partition/recursive_partitioner.h"
+
+#include <memory>
+#include <vector>
+
+namespace obsgroup {
+
+/// Groups observations into consistent local maps (Blanco, Gonzalez,
+/// Fernandez-Madrigal, ICRA 2006): W_ij = Psi(n_i, n_j) (eq. 18), then
+/// recursive spectral bisection by minimum normalized cut (sec. II).
+///
+/// \code
+///   obsgroup::ObservationGrouping<pcl::PointXYZ> grouping;
+///   for (const auto& [cloud, pose] : scans) grouping.addObservation(cloud, pose);
+///   grouping.setMatchDistance(0.1);
+///   const obsgroup::Partition partition = grouping.compute();
+/// \endcode
+template <typename PointT>
+class ObservationGrouping {
+ public:
+  using Ptr = std::shared_ptr<ObservationGrouping<PointT>>;
+  using ConstPtr = std::shared_ptr<const ObservationGrouping<PointT>>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using PointCloudConstPtr = typename PointCloud::ConstPtr;
+  using SearchMethodPtr = typename SensedSpaceOverlap<PointT>::SearchMethodPtr;
+
+  /// Adds an observation: points in the sensor frame and the sensor's pose.
+  void addObservation(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose);
+  /// Adds an observation whose pose is the cloud's own sensor_origin_ and
+  /// sensor_orientation_ (a PCD file's VIEWPOINT).
+  void addObservation(const PointCloudConstPtr& cloud);
+  const std::vector<Observation<PointT>>& getObservations() const { return observations_; }
+  /// Removes all observations and results.
+  void clear();
+
+  // --- sensed-space overlap (sec. IV-A) ---
+  void setMatchDistance(double delta) { overlap_.setMatchDistance(delta); }
+  double getMatchDistance() const { return overlap_.getMatchDistance(); }
+  void setVoxelLeafSize(double leaf) { overlap_.setVoxelLeafSize(leaf); }
+  double getVoxelLeafSize() const { return overlap_.getVoxelLeafSize(); }
+  void setNeighbourSearch(NeighbourSearch method) { overlap_.setNeighbourSearch(method); }
+  NeighbourSearch getNeighbourSearch() const { return overlap_.getNeighbourSearch(); }
+  void setSearchMethod(const SearchMethodPtr& search) { overlap_.setSearchMethod(search); }
+  SearchMethodPtr getSearchMethod() const { return overlap_.getSearchMethod(); }
+  void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
+  int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
+
+  // --- graph and partition (sec. II, III) ---
+  /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
+  void setDiagonalWeight(double value) { diagonal_ = value; }
+  double getDiagonalWeight() const { return diagonal_; }
+  void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; }
+  double getNcutThreshold() const { return options_.ncut_threshold; }
+  void setSplitCriterion(SplitCriterion criterion) { options_.split = criterion; }
+  SplitCriterion getSplitCriterion() const { return options_.split; }
+  void setMinGroupSize(int size) { options_.min_group_size = size; }
+  int getMinGroupSize() const { return options_.min_group_size; }
+  void setMaxDepth(int depth) { options_.max_depth = depth; }
+  int getMaxDepth() const { return options_.max_depth; }
+  void setEigenSolver(EigenSolver solver) { options_.eigen.solver = solver; }
+  EigenSolver getEigenSolver() const { return options_.eigen.solver; }
+  void setPartitionOptions(const PartitionOptions& options) { options_ = options; }
+  const PartitionOptions& getPartitionOptions() const { return options_; }
+
+  /// Computes the overlap, builds W and partitions it. Throws
+  /// std::invalid_argument on bad parameters or observations.
+  Partition compute();
+
+  /// The weight matrix W of the last compute() (diagonal as configured).
+  const WeightMatrix& getWeightMatrix() const { return W_; }
+  /// Pi, Psi and work statistics of the last compute().
+  const OverlapResult& getOverlap() const { return overlap_result_; }
+
+ private:
+  std::vector<Observation<PointT>> observations_;
+  SensedSpaceOverlap<PointT> overlap_;
+  double diagonal_ = kDefaultDiagonalWeight;
+  PartitionOptions options_;
+  OverlapResult overlap_result_;
+  WeightMatrix W_;
+};
+
+}  // namespace obsgroup
+
+#if defined(PCL_NO_PRECOMPILE) || defined(OBSGROUP_NO_PRECOMPILE)
+#include "obsgroup/impl/observation_grouping.hpp"
+#endif

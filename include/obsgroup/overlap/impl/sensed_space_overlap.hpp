@@ -1,0 +1,168 @@
+#pragma once
+
+#include "obsgroup/overlap/sensed_space_overlap.h"
+#include "obsgroup/overlap/shared_grid_matcher.h"
+
+#include <pcl/common/common.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/search/kdtree.h>
+
+#include <omp.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace obsgroup {
+
+template <typename PointT>
+std::vector<Eigen::Vector3f> SensedSpaceOverlap<PointT>::observationToWorld(
+    const Observation<PointT>& observation, const Eigen::Vector3d& origin) const {
+  if (!observation.cloud) throw std::invalid_argument("observation has no cloud (null pointer)");
+  if (!observation.pose.matrix().allFinite()) throw std::invalid_argument("observation pose is not finite");
+
+  // NaN/Inf points carry no sensed space; a cloud marked dense may still hold
+  // them, so every point is checked rather than trusting is_dense.
+  PointCloud finite;
+  finite.reserve(observation.cloud->size());
+  for (const PointT& p : observation.cloud->points)
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) finite.push_back(p);
+
+  PointCloud filtered;
+  const PointCloud* used = &finite;
+  if (voxel_leaf_ > 0.0 && !finite.empty()) {
+    // pcl::VoxelGrid silently returns its input when the voxel count would
+    // overflow its 32-bit indices; refuse instead of matching unfiltered data.
+    Eigen::Vector4f min_pt, max_pt;
+    pcl::getMinMax3D(finite, min_pt, max_pt);
+    const Eigen::Array3d cells =
+        ((max_pt - min_pt).head<3>().cast<double>() / voxel_leaf_).array().floor() + 1.0;
+    if (cells.prod() > double(std::numeric_limits<std::int32_t>::max()))
+      throw std::invalid_argument("voxel leaf " + std::to_string(voxel_leaf_) +
+                                  " m is too small for a cloud of extent " +
+                                  std::to_string((max_pt - min_pt).head<3>().maxCoeff()) + " m");
+    pcl::VoxelGrid<PointT> voxel;
+    voxel.setLeafSize(float(voxel_leaf_), float(voxel_leaf_), float(voxel_leaf_));
+    voxel.setInputCloud(typename PointCloud::ConstPtr(&finite, [](const PointCloud*) {}));
+    voxel.filter(filtered);
+    used = &filtered;
+  }
+
+  // The pose is applied in double and the result re-centred before rounding
+  // to float (see WorldPoints).
+  const Eigen::Matrix3d R = observation.pose.linear();
+  const Eigen::Vector3d t = observation.pose.translation() - origin;
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(used->size());
+  for (const PointT& p : used->points)
+    out.push_back((R * Eigen::Vector3d(p.x, p.y, p.z) + t).template cast<float>());
+  return out;
+}
+
+template <typename PointT>
+WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<PointT>>& observations) const {
+  if (!(voxel_leaf_ >= 0.0) || !std::isfinite(voxel_leaf_))
+    throw std::invalid_argument("voxel leaf size must be finite and >= 0");
+  const int n = static_cast<int>(observations.size());
+  WorldPoints world;
+  if (n > 0 && observations[0].pose.translation().allFinite())
+    world.origin = observations[0].pose.translation();
+
+  std::vector<std::vector<Eigen::Vector3f>> per_observation(n);
+  std::vector<std::string> errors(n);
+  const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
+  for (int i = 0; i < n; ++i) {
+    try {
+      per_observation[i] = observationToWorld(observations[i], world.origin);
+    } catch (const std::exception& e) {
+      errors[i] = e.what();
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    if (!errors[i].empty()) throw std::invalid_argument("observation " + std::to_string(i) + ": " + errors[i]);
+  for (auto& points : per_observation) {
+    world.append(points);
+    std::vector<Eigen::Vector3f>().swap(points);
+  }
+  return world;
+}
+
+template <typename PointT>
+MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints& world) const {
+  const int n = world.size();
+  const auto candidates = overlappingBoxes(world, delta_);
+  const double delta_sq = delta_ * delta_;
+  // The search runs in float: ask a slightly larger radius, then decide with
+  // the exact predicate shared with the grid back-end.
+  const double radius = delta_ * (1.0 + 1e-5);
+  std::vector<std::vector<MatchCount>> columns(n);  // columns[j]: (i, count) with i ascending
+  std::uint64_t pairs = 0, tests = 0;
+  const int threads = search_ ? 1 : (threads_ > 0 ? threads_ : omp_get_max_threads());
+
+#pragma omp parallel num_threads(threads) reduction(+ : pairs, tests)
+  {
+    SearchMethodPtr search = search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false));
+    pcl::Indices indices;
+    std::vector<float> sq_distances;
+#pragma omp for schedule(dynamic, 4)
+    for (int j = 0; j < n; ++j) {
+      if (candidates[j].empty()) continue;
+      typename PointCloud::Ptr target(new PointCloud);
+      target->resize(world.count(j));
+      for (std::size_t k = 0; k < world.count(j); ++k) {
+        const Eigen::Vector3f& q = world.begin(j)[k];
+        (*target)[k].x = q.x();
+        (*target)[k].y = q.y();
+        (*target)[k].z = q.z();
+      }
+      search->setInputCloud(target);
+      for (int i : candidates[j]) {
+        ++pairs;
+        std::uint32_t count = 0;
+        PointT query;
+        for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+          ++tests;
+          query.x = p->x();
+          query.y = p->y();
+          query.z = p->z();
+          // The nearest neighbour decides, unless float rounding put it just
+          // outside delta: then every neighbour in the radius is checked.
+          if (search->radiusSearch(query, radius, indices, sq_distances, 1) == 0) continue;
+          bool match = withinMatchDistance(*p, world.begin(j)[indices[0]], delta_sq);
+          if (!match) {
+            search->radiusSearch(query, radius, indices, sq_distances, 0);
+            for (const auto k : indices) match = match || withinMatchDistance(*p, world.begin(j)[k], delta_sq);
+          }
+          count += match;
+        }
+        if (count > 0) columns[j].push_back({i, count});
+      }
+    }
+  }
+
+  MatchCounts out;
+  out.rows.resize(n);
+  for (int j = 0; j < n; ++j)
+    for (const MatchCount& m : columns[j]) out.rows[m.j].push_back({j, m.count});
+  out.pairs_evaluated = pairs;
+  out.point_tests = tests;
+  return out;
+}
+
+template <typename PointT>
+OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<PointT>>& observations) const {
+  if (!(delta_ > 0.0) || !std::isfinite(delta_))
+    throw std::invalid_argument("match distance delta must be finite and > 0");
+  const WorldPoints world = toWorld(observations);
+  const MatchCounts counts = neighbour_search_ == NeighbourSearch::SharedGrid
+                                 ? countMatchesSharedGrid(world, delta_, threads_)
+                                 : countMatchesPclSearch(world);
+  return assembleOverlap(counts, world);
+}
+
+}  // namespace obsgroup
+
+#define OBSGROUP_INSTANTIATE_SensedSpaceOverlap(T) template class obsgroup::SensedSpaceOverlap<T>;

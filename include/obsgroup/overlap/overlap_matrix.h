@@ -1,0 +1,43 @@
+#pragma once
+/// \file
+/// From per-pair match counts to Pi (eq. 17) and Psi (eq. 18).
+
+#include "obsgroup/graph/observation_graph.h"
+#include "obsgroup/overlap/world_points.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace obsgroup {
+
+/// Number of points of one observation i that have a point of observation j
+/// within delta (the sum of eq. 17 before dividing by M).
+struct MatchCount {
+  int j = 0;
+  std::uint32_t count = 0;
+};
+
+/// Output of a neighbour back-end: for each observation i, the observations it
+/// matched (ascending j, count > 0), plus work statistics.
+struct MatchCounts {
+  std::vector<std::vector<MatchCount>> rows;
+  std::uint64_t pairs_evaluated = 0;  ///< Ordered pairs (i, j) whose points were compared.
+  std::uint64_t point_tests = 0;      ///< Point-to-observation tests (one per point i and nearby j).
+};
+
+/// The sensed-space overlap of a set of observations.
+struct OverlapResult {
+  /// Pi(n_i, n_j, delta), eq. (17): row i, column j; not symmetric (Fig. 4).
+  Eigen::SparseMatrix<double, Eigen::RowMajor> match_ratio;
+  /// Psi(n_i, n_j) = (Pi_ij + Pi_ji) / 2, eq. (18), for each pair i < j with Psi > 0.
+  std::vector<WeightedPair> pairs;
+  std::vector<std::size_t> points_per_observation;  ///< M of eq. (17), after filtering.
+  std::uint64_t pairs_evaluated = 0;
+  std::uint64_t point_tests = 0;
+};
+
+/// Divides the counts by M (eq. 17) and symmetrises them (eq. 18).
+/// An observation without points matches nothing: its Pi row is 0.
+OverlapResult assembleOverlap(const MatchCounts& counts, const WorldPoints& world);
+
+}  // namespace obsgroup

@@ -1,0 +1,90 @@
+#pragma once
+/// \file
+/// Sensed-space overlap (SSO) of paper sec. IV-A, eq. (16)-(18), for any PCL
+/// point type with x, y, z.
+
+#include "obsgroup/observation.h"
+#include "obsgroup/overlap/overlap_matrix.h"
+#include "obsgroup/overlap/world_points.h"
+
+#include <pcl/search/search.h>
+
+#include <memory>
+#include <vector>
+
+namespace obsgroup {
+
+/// How the points of one observation find a point of another within delta.
+enum class NeighbourSearch {
+  SharedGrid,  ///< One spatial hash over all observations (the default, one pass).
+  PclSearch    ///< One pcl::search::Search per observation (kd-tree by default).
+};
+
+/// Computes Pi (eq. 17) and Psi (eq. 18) for all pairs of observations.
+///
+/// Each observation's points are cleaned of NaN/Inf, optionally downsampled
+/// with pcl::VoxelGrid in the sensor frame, and moved to the world frame. Both
+/// neighbour back-ends give the same matrix: they decide a match with the
+/// same double-precision predicate on the same coordinates. Pairs whose
+/// bounding boxes, grown by delta, do not intersect are never compared.
+template <typename PointT>
+class SensedSpaceOverlap {
+ public:
+  using Ptr = std::shared_ptr<SensedSpaceOverlap<PointT>>;
+  using ConstPtr = std::shared_ptr<const SensedSpaceOverlap<PointT>>;
+  using PointCloud = pcl::PointCloud<PointT>;
+  using SearchMethod = pcl::search::Search<PointT>;
+  using SearchMethodPtr = typename SearchMethod::Ptr;
+
+  /// Tolerance delta of the match function C, eq. (16), in metres (default 0.1).
+  void setMatchDistance(double delta) { delta_ = delta; }
+  double getMatchDistance() const { return delta_; }
+
+  /// Leaf size of the voxel downsampling applied to each observation before
+  /// matching, in metres; 0 (the default) disables it.
+  void setVoxelLeafSize(double leaf) { voxel_leaf_ = leaf; }
+  double getVoxelLeafSize() const { return voxel_leaf_; }
+
+  void setNeighbourSearch(NeighbourSearch method) { neighbour_search_ = method; }
+  NeighbourSearch getNeighbourSearch() const { return neighbour_search_; }
+
+  /// A PCL search object for the PclSearch back-end, as PCL algorithms take
+  /// one. It is given each observation in turn with setInputCloud(), so the
+  /// back-end then runs on one thread. Without it, each thread makes its own
+  /// pcl::search::KdTree. Setting it selects NeighbourSearch::PclSearch.
+  void setSearchMethod(const SearchMethodPtr& search) {
+    search_ = search;
+    neighbour_search_ = NeighbourSearch::PclSearch;
+  }
+  SearchMethodPtr getSearchMethod() const { return search_; }
+
+  /// Threads for the per-observation work; 0 (the default) uses OpenMP's
+  /// default. The result is bit-for-bit the same for any value.
+  void setNumberOfThreads(int threads) { threads_ = threads; }
+  int getNumberOfThreads() const { return threads_; }
+
+  /// Filters and moves every observation to the common frame. Throws
+  /// std::invalid_argument on a null cloud, a non-finite pose or a voxel
+  /// leaf too small for a cloud's extent.
+  WorldPoints toWorld(const std::vector<Observation<PointT>>& observations) const;
+
+  /// Pi and Psi for all pairs. Throws std::invalid_argument on bad parameters.
+  OverlapResult compute(const std::vector<Observation<PointT>>& observations) const;
+
+ private:
+  std::vector<Eigen::Vector3f> observationToWorld(const Observation<PointT>& observation,
+                                                  const Eigen::Vector3d& origin) const;
+  MatchCounts countMatchesPclSearch(const WorldPoints& world) const;
+
+  double delta_ = 0.1;
+  double voxel_leaf_ = 0.0;
+  NeighbourSearch neighbour_search_ = NeighbourSearch::SharedGrid;
+  SearchMethodPtr search_;
+  int threads_ = 0;
+};
+
+}  // namespace obsgroup
+
+#if defined(PCL_NO_PRECOMPILE) || defined(OBSGROUP_NO_PRECOMPILE)
+#include "obsgroup/overlap/impl/sensed_space_overlap.hpp"
+#endif

@@ -1,0 +1,22 @@
+#pragma once
+/// \file
+/// The shared-grid neighbour back-end: one spatial hash over every
+/// observation's world points, so the whole overlap matrix comes from a
+/// single pass over the points.
+
+#include "obsgroup/overlap/overlap_matrix.h"
+
+namespace obsgroup {
+
+/// Counts, for every observation i and every other observation j, the points
+/// of i with a point of j within delta (eq. 16-17).
+///
+/// The grid's cells are a hair larger than delta, so two points within delta
+/// always fall in the same or adjacent cells whatever the rounding of the
+/// cell index; the match itself is decided by withinMatchDistance(). Each
+/// point is tested against the 3x3 (flat data) or 3x3x3 neighbouring cells,
+/// and each nearby observation is counted at most once per point. Rows are
+/// independent, so the result is the same for any number of threads.
+MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0);
+
+}  // namespace obsgroup

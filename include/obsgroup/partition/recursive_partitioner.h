@@ -1,0 +1,76 @@
+#pragma once
+/// \file
+/// RecursivePart of paper sec. II-B: recursive spectral bisection while the
+/// minimum normalized cut stays below a threshold.
+
+#include "obsgroup/graph/observation_graph.h"
+#include "obsgroup/spectral/spectral_bisection.h"
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace obsgroup {
+
+struct PartitionOptions {
+  /// A bisection is accepted while Ncut < threshold. The paper derives 1 from
+  /// the geometric mean of the intra-group cohesions, eq. (12)-(13).
+  double ncut_threshold = 1.0;
+  SplitCriterion split = SplitCriterion::Mean;
+  /// A bisection giving a group smaller than this is rejected.
+  int min_group_size = 1;
+  /// Bisections deeper than this are not attempted (components still split).
+  int max_depth = std::numeric_limits<int>::max();
+  /// Keep each node's eigenvector in the split tree (for plots and analysis).
+  bool keep_eigenvectors = true;
+  FiedlerOptions eigen;
+};
+
+/// One node of the split tree.
+struct SplitNode {
+  enum class Kind {
+    Leaf,        ///< Not split: it is a group. `outcome` says why.
+    Components,  ///< Disconnected: split into its connected components (Ncut 0).
+    Bisection    ///< Spectral bisection accepted.
+  };
+  /// Why a node ended as it did.
+  enum class Outcome {
+    Accepted,          ///< Split (Components or Bisection).
+    NcutAboveThreshold,///< Bisection computed, Ncut >= threshold.
+    GroupTooSmall,     ///< Bisection computed, a side below min_group_size.
+    NoSplit,           ///< Bisection computed, all nodes on one side.
+    MaxDepth,          ///< Not attempted: max_depth reached.
+    TooFewNodes        ///< Not attempted: a single node, or fewer than 2 * min_group_size.
+  };
+  std::vector<int> members;   ///< Observation indices, ascending.
+  Kind kind = Kind::Leaf;
+  Outcome outcome = Outcome::TooFewNodes;
+  bool accepted = false;      ///< A split was made (kind != Leaf).
+  bool attempted = false;     ///< A spectral bisection was computed at this node.
+  double ncut = std::numeric_limits<double>::quiet_NaN();  ///< Eq. (1); 0 for components.
+  double threshold = 0.0;     ///< Eigenvector threshold of the bisection.
+  double eigenvalue = std::numeric_limits<double>::quiet_NaN();
+  bool sparse_solver = false;
+  Eigen::VectorXd eigenvector;  ///< y over `members` (empty unless kept).
+  int depth = 0;              ///< Number of accepted bisections above this node.
+  int parent = -1;
+  std::vector<int> children;  ///< Indices into Partition::splits.
+};
+
+std::string toString(SplitNode::Kind kind);
+std::string toString(SplitNode::Outcome outcome);
+
+struct Partition {
+  /// Groups of observation indices: each ascending, every index exactly once,
+  /// groups ordered by their first (smallest) observation.
+  std::vector<std::vector<int>> groups;
+  /// group_of[i] is the group of observation i.
+  std::vector<int> group_of;
+  /// The split tree in breadth-first order; splits[0] is the root.
+  std::vector<SplitNode> splits;
+};
+
+/// Partitions the graph W (with its diagonal as configured) recursively.
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options = {});
+
+}  // namespace obsgroup

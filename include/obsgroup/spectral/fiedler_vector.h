@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// Second smallest eigenvector of the generalized problem (D - W) y = lambda D y,
+/// paper eq. (10), through the normalized form of eq. (11).
+
+#include "obsgroup/graph/observation_graph.h"
+
+#include <Eigen/Core>
+
+namespace obsgroup {
+
+/// Which eigen solver computes the Fiedler vector.
+enum class EigenSolver {
+  Auto,   ///< Dense below FiedlerOptions::dense_max_size nodes, sparse above.
+  Dense,  ///< Eigen::SelfAdjointEigenSolver on the dense normalized Laplacian.
+  Sparse  ///< Spectra Lanczos in shift-invert mode on the sparse Laplacian.
+};
+
+struct FiedlerOptions {
+  EigenSolver solver = EigenSolver::Auto;
+  /// Largest graph solved densely by EigenSolver::Auto (measured: see
+  /// docs/performance-notes.md; the sparse solver wins from about this size).
+  int dense_max_size = 200;
+  /// Relative tolerance of the Lanczos iteration.
+  double tolerance = 1e-10;
+  /// Maximum number of restarts of the Lanczos iteration.
+  int max_iterations = 1000;
+};
+
+struct FiedlerResult {
+  /// y_1 of eq. (10), y = D^-1/2 z with ||z|| = 1, sign fixed so that the
+  /// first clearly non-zero component is positive (dense and sparse agree).
+  Eigen::VectorXd y;
+  double eigenvalue = 0.0;  ///< lambda_1 of eq. (10)/(11).
+  bool sparse = false;      ///< true when Spectra computed it.
+  bool fell_back = false;   ///< true when Spectra failed and the dense solver was used.
+};
+
+/// Fiedler vector of a connected graph with positive degrees (the recursive
+/// partitioner splits off connected components first, so the zero eigenvalue
+/// is simple). Throws std::invalid_argument on a graph with fewer than two
+/// nodes or a node of zero degree, std::runtime_error if no solver converges.
+FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options = {});
+
+}  // namespace obsgroup

@@ -1,0 +1,39 @@
+#pragma once
+/// \file
+/// Spectral bisection of a graph by minimum normalized cut (paper sec. II-A).
+
+#include "obsgroup/spectral/fiedler_vector.h"
+#include "obsgroup/spectral/normalized_cut.h"
+
+#include <string>
+#include <vector>
+
+namespace obsgroup {
+
+/// How the real-valued Fiedler vector is turned into two groups.
+enum class SplitCriterion {
+  Mean,    ///< y_i > mean(y): the paper's choice (sec. II-A), the default.
+  Sign,    ///< y_i > 0.
+  BestNcut ///< sweep every threshold along the sorted y and keep the smallest Ncut.
+};
+
+std::string toString(SplitCriterion criterion);
+/// Parses "mean", "sign" or "best"; throws std::invalid_argument otherwise.
+SplitCriterion splitCriterionFromString(const std::string& name);
+
+struct Bisection {
+  FiedlerResult fiedler;    ///< The eigenvector the split was read from.
+  double threshold = 0.0;   ///< Nodes with y_i > threshold go to A.
+  std::vector<bool> in_a;   ///< Membership of each node in A.
+  CutValues cut;            ///< Exact Ncut of this split, eq. (1).
+  /// False when every node fell on one side (no split exists, e.g. all y equal).
+  bool valid = false;
+};
+
+/// Bisects a connected graph (positive degrees, at least 2 nodes). For
+/// BestNcut, only thresholds leaving at least `min_side` nodes on each side
+/// are considered.
+Bisection spectralBisection(const WeightMatrix& W, SplitCriterion criterion,
+                            const FiedlerOptions& options = {}, int min_side = 1);
+
+}  // namespace obsgroup

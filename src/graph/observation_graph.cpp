@@ -1,0 +1,94 @@
+#include "obsgroup/graph/observation_graph.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace obsgroup {
+
+WeightMatrix buildWeightMatrix(int n, const std::vector<WeightedPair>& pairs, double diagonal) {
+  if (n < 0) throw std::invalid_argument("buildWeightMatrix: negative size");
+  if (!std::isfinite(diagonal) || diagonal < 0.0)
+    throw std::invalid_argument("buildWeightMatrix: diagonal weight must be finite and >= 0");
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(2 * pairs.size() + (diagonal != 0.0 ? n : 0));
+  for (const auto& p : pairs) {
+    if (p.i < 0 || p.j < 0 || p.i >= n || p.j >= n || p.i == p.j)
+      throw std::invalid_argument("buildWeightMatrix: bad pair (" + std::to_string(p.i) + ", " +
+                                  std::to_string(p.j) + ") for " + std::to_string(n) + " nodes");
+    if (!std::isfinite(p.weight) || p.weight < 0.0)
+      throw std::invalid_argument("buildWeightMatrix: weight of pair (" + std::to_string(p.i) +
+                                  ", " + std::to_string(p.j) + ") is not finite and >= 0");
+    if (p.weight == 0.0) continue;
+    triplets.emplace_back(p.i, p.j, p.weight);
+    triplets.emplace_back(p.j, p.i, p.weight);
+  }
+  if (diagonal != 0.0)
+    for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal);
+  WeightMatrix W(n, n);
+  // A duplicated pair must not be summed silently into a weight above 1.
+  bool duplicate = false;
+  W.setFromTriplets(triplets.begin(), triplets.end(), [&duplicate](double a, double) {
+    duplicate = true;
+    return a;
+  });
+  if (duplicate) throw std::invalid_argument("buildWeightMatrix: a pair is given twice");
+  W.makeCompressed();
+  return W;
+}
+
+Eigen::VectorXd degrees(const WeightMatrix& W) {
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(W.outerSize());
+  for (int k = 0; k < W.outerSize(); ++k)
+    for (WeightMatrix::InnerIterator it(W, k); it; ++it) d[k] += it.value();
+  return d;
+}
+
+WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members) {
+  const int m = static_cast<int>(members.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int local_col = 0; local_col < m; ++local_col) {
+    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it) {
+      // members is sorted: a binary search keeps this O(nnz log m) with no O(N) scratch.
+      const auto pos = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
+      if (pos != members.end() && *pos == it.row())
+        triplets.emplace_back(static_cast<int>(pos - members.begin()), local_col, it.value());
+    }
+  }
+  WeightMatrix sub(m, m);
+  sub.setFromTriplets(triplets.begin(), triplets.end());
+  sub.makeCompressed();
+  return sub;
+}
+
+std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W) {
+  const int n = static_cast<int>(W.outerSize());
+  std::vector<int> label(n, -1);
+  std::vector<std::vector<int>> components;
+  std::vector<int> stack;
+  // Seeds are visited in ascending order, so components come out ordered by
+  // their smallest node.
+  for (int seed = 0; seed < n; ++seed) {
+    if (label[seed] >= 0) continue;
+    const int c = static_cast<int>(components.size());
+    components.emplace_back();
+    label[seed] = c;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      components[c].push_back(u);
+      for (WeightMatrix::InnerIterator it(W, u); it; ++it) {
+        const int v = static_cast<int>(it.row());
+        if (v == u || it.value() == 0.0 || label[v] >= 0) continue;
+        label[v] = c;
+        stack.push_back(v);
+      }
+    }
+    std::sort(components[c].begin(), components[c].end());
+  }
+  return components;
+}
+
+}  // namespace obsgroup

@@ -1,0 +1,248 @@
+#include "obsgroup/overlap/shared_grid_matcher.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace obsgroup {
+namespace {
+
+struct CellKey {
+  std::int32_t x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+  bool operator<(const CellKey& o) const {
+    return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z);
+  }
+};
+
+/// A run of consecutive grid points of one observation inside one cell.
+struct Run {
+  std::int32_t observation;
+  std::uint32_t begin, end;  // into Grid::points
+};
+
+/// Open-addressing hash table from a cell to its runs. Built once, read-only
+/// afterwards, so all threads share it without locks.
+class CellTable {
+ public:
+  void reserve(std::size_t cells) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * cells) capacity <<= 1;
+    mask_ = capacity - 1;
+    slots_.assign(capacity, Slot{});
+  }
+  void insert(const CellKey& key, std::uint32_t run_begin, std::uint32_t run_end) {
+    std::size_t s = hash(key) & mask_;
+    while (slots_[s].run_end != 0) s = (s + 1) & mask_;
+    slots_[s] = Slot{key, run_begin, run_end};
+  }
+  /// Runs of a cell as [begin, end) into the run array; begin == end if empty.
+  std::pair<std::uint32_t, std::uint32_t> find(const CellKey& key) const {
+    for (std::size_t s = hash(key) & mask_;; s = (s + 1) & mask_) {
+      const Slot& slot = slots_[s];
+      if (slot.run_end == 0) return {0, 0};
+      if (slot.key == key) return {slot.run_begin, slot.run_end};
+    }
+  }
+
+ private:
+  struct Slot {
+    CellKey key{0, 0, 0};
+    std::uint32_t run_begin = 0, run_end = 0;  // run_end == 0 marks a free slot
+  };
+  static std::size_t hash(const CellKey& k) {
+    std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ull;
+    h ^= std::uint64_t(std::uint32_t(k.y)) * 0xC2B2AE3D27D4EB4Full;
+    h ^= std::uint64_t(std::uint32_t(k.z)) * 0x165667B19E3779F9ull;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+};
+
+class Grid {
+ public:
+  Grid(const WorldPoints& world, double delta) : world_(world) {
+    // Cells a hair larger than delta: two points within delta then differ by
+    // at most one in every cell index, whatever the rounding of x / cell.
+    inv_cell_ = 1.0 / (delta * (1.0 + 1e-6));
+    build();
+  }
+
+  CellKey cellOf(const Eigen::Vector3f& p) const {
+    const auto index = [this](float v) {
+      const double c = std::floor(double(v) * inv_cell_);
+      if (!(std::abs(c) < double(1 << 30)))
+        throw std::invalid_argument("shared grid: a point lies too far from the map centre for the grid "
+                                    "(coordinate " + std::to_string(v) + " m); use a larger delta or the "
+                                    "PCL search back-end");
+      return static_cast<std::int32_t>(c);
+    };
+    return {index(p.x()), index(p.y()), index(p.z())};
+  }
+
+  bool flat() const { return flat_; }
+  const CellTable& table() const { return table_; }
+  const std::vector<Run>& runs() const { return runs_; }
+  const std::vector<Eigen::Vector3f>& points() const { return points_; }
+
+ private:
+  void build() {
+    const std::size_t total = world_.points.size();
+    if (total >= std::numeric_limits<std::uint32_t>::max())
+      throw std::invalid_argument("shared grid: more than 4 billion points");
+    struct Entry {
+      CellKey key;
+      std::int32_t observation;
+      std::uint32_t index;
+    };
+    std::vector<Entry> entries(total);
+    for (int i = 0; i < world_.size(); ++i)
+      for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
+        entries[k] = Entry{cellOf(world_.points[k]), i, static_cast<std::uint32_t>(k)};
+    // Sorting by (cell, observation, index) groups each cell's points into one
+    // run per observation, in a deterministic order.
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      if (!(a.key == b.key)) return a.key < b.key;
+      return a.observation != b.observation ? a.observation < b.observation : a.index < b.index;
+    });
+    points_.resize(total);
+    flat_ = true;
+    std::size_t cells = 0;
+    for (std::size_t k = 0; k < total; ++k) {
+      points_[k] = world_.points[entries[k].index];
+      flat_ = flat_ && entries[k].key.z == entries[0].key.z;
+      if (k == 0 || !(entries[k].key == entries[k - 1].key)) ++cells;
+    }
+    table_.reserve(cells);
+    std::size_t cell_first_run = 0;
+    for (std::size_t k = 0; k < total; ++k) {
+      const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
+      if (new_cell && k > 0) table_.insert(entries[k - 1].key, cell_first_run, runs_.size());
+      if (new_cell) cell_first_run = runs_.size();
+      if (new_cell || entries[k].observation != entries[k - 1].observation)
+        runs_.push_back(Run{entries[k].observation, static_cast<std::uint32_t>(k), 0});
+      runs_.back().end = static_cast<std::uint32_t>(k + 1);
+    }
+    if (total > 0) table_.insert(entries[total - 1].key, cell_first_run, runs_.size());
+  }
+
+  const WorldPoints& world_;
+  double inv_cell_ = 0.0;
+  bool flat_ = true;
+  CellTable table_;
+  std::vector<Run> runs_;
+  std::vector<Eigen::Vector3f> points_;
+};
+
+/// Per-thread scratch for one row of counts: dense by observation, reset only
+/// where touched, so a row costs O(matches), not O(N).
+struct RowScratch {
+  explicit RowScratch(int n) : seen(n, 0), tested(n, -1), count(n, 0) {}
+  std::vector<std::uint32_t> seen;  // point stamp of the last match with j
+  std::vector<int> tested;          // last row i that compared points with j
+  std::vector<std::uint32_t> count;
+  std::vector<int> touched;
+  std::uint32_t stamp = 0;
+  std::uint64_t pairs = 0, tests = 0;
+
+  void nextPoint() {
+    if (++stamp == 0) {  // wrapped: forget old stamps
+      std::fill(seen.begin(), seen.end(), 0);
+      stamp = 1;
+    }
+  }
+};
+
+void countRow(const Grid& grid, const WorldPoints& world, int i, double delta_sq, RowScratch& s,
+              std::vector<MatchCount>& row) {
+  // Visit i's points cell by cell, so each neighbourhood is looked up once per cell.
+  const std::size_t m = world.count(i);
+  std::vector<std::pair<CellKey, std::uint32_t>> cells(m);
+  for (std::size_t k = 0; k < m; ++k) cells[k] = {grid.cellOf(world.begin(i)[k]), static_cast<std::uint32_t>(k)};
+  std::sort(cells.begin(), cells.end(), [](const auto& a, const auto& b) {
+    return a.first == b.first ? a.second < b.second : a.first < b.first;
+  });
+  const int dz_max = grid.flat() ? 0 : 1;
+  std::array<std::pair<std::uint32_t, std::uint32_t>, 27> neighbourhood;
+  for (std::size_t first = 0; first < m;) {
+    const CellKey c = cells[first].first;
+    int used = 0;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -dz_max; dz <= dz_max; ++dz) {
+          const auto runs = grid.table().find({c.x + dx, c.y + dy, c.z + dz});
+          if (runs.first != runs.second) neighbourhood[used++] = runs;
+        }
+    std::size_t last = first;
+    for (; last < m && cells[last].first == c; ++last) {
+      const Eigen::Vector3f& p = world.begin(i)[cells[last].second];
+      s.nextPoint();
+      for (int h = 0; h < used; ++h) {
+        for (std::uint32_t r = neighbourhood[h].first; r < neighbourhood[h].second; ++r) {
+          const Run& run = grid.runs()[r];
+          const int j = run.observation;
+          if (j == i || s.seen[j] == s.stamp) continue;  // each j counted once per point
+          if (s.tested[j] != i) {
+            s.tested[j] = i;
+            ++s.pairs;
+          }
+          ++s.tests;
+          for (std::uint32_t q = run.begin; q < run.end; ++q) {
+            if (withinMatchDistance(p, grid.points()[q], delta_sq)) {
+              s.seen[j] = s.stamp;
+              if (s.count[j]++ == 0) s.touched.push_back(j);
+              break;
+            }
+          }
+        }
+      }
+    }
+    first = last;
+  }
+  std::sort(s.touched.begin(), s.touched.end());
+  row.reserve(s.touched.size());
+  for (int j : s.touched) {
+    row.push_back({j, s.count[j]});
+    s.count[j] = 0;
+  }
+  s.touched.clear();
+}
+
+}  // namespace
+
+MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads) {
+  if (!(delta > 0.0) || !std::isfinite(delta))
+    throw std::invalid_argument("shared grid: the match distance delta must be finite and > 0");
+  const int n = world.size();
+  MatchCounts out;
+  out.rows.resize(n);
+  if (n == 0) return out;
+  const Grid grid(world, delta);
+  const double delta_sq = delta * delta;
+  const int nthreads = threads > 0 ? threads : omp_get_max_threads();
+  std::uint64_t pairs = 0, tests = 0;
+  // Every point's cell was computed (and range-checked) when the grid was
+  // built, so nothing below can throw inside the parallel region.
+#pragma omp parallel num_threads(nthreads) reduction(+ : pairs, tests)
+  {
+    RowScratch scratch(n);
+#pragma omp for schedule(dynamic, 8)
+    for (int i = 0; i < n; ++i) countRow(grid, world, i, delta_sq, scratch, out.rows[i]);
+    pairs += scratch.pairs;
+    tests += scratch.tests;
+  }
+  out.pairs_evaluated = pairs;
+  out.point_tests = tests;
+  return out;
+}
+
+}  // namespace obsgroup

@@ -1,0 +1,129 @@
+#include "obsgroup/spectral/fiedler_vector.h"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <Spectra/SymEigsSolver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace obsgroup {
+namespace {
+
+/// Normalized Laplacian of eq. (11): I - D^-1/2 W D^-1/2, written as
+/// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured.
+WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d) {
+  WeightMatrix L = -W;
+  L += WeightMatrix(Eigen::VectorXd(inv_sqrt_d.cwiseInverse().cwiseAbs2()).asDiagonal());
+  L = inv_sqrt_d.asDiagonal() * L * inv_sqrt_d.asDiagonal();
+  L.makeCompressed();
+  return L;
+}
+
+/// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
+/// null vector of eq. (11)). Its largest eigenvalue is 1/lambda_1, so Lanczos
+/// converges at the rate lambda_1/lambda_2 with no shift to tune. L^+ is
+/// applied exactly by grounding: for b orthogonal to z0, L x = b has a solution
+/// with x_last = 0, found with a Cholesky factor of L without its last row and
+/// column (positive definite for a connected graph).
+class DeflatedLaplacianInverse {
+ public:
+  using Scalar = double;
+
+  DeflatedLaplacianInverse(const WeightMatrix& L, Eigen::VectorXd z0)
+      : n_(L.rows()), z0_(std::move(z0)) {
+    ldlt_.compute(WeightMatrix(L.topLeftCorner(n_ - 1, n_ - 1)));
+    if (ldlt_.info() != Eigen::Success)
+      throw std::runtime_error("Fiedler vector: the grounded Laplacian could not be factorised");
+  }
+  Eigen::Index rows() const { return n_; }
+  Eigen::Index cols() const { return n_; }
+
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::Map<const Eigen::VectorXd> x(x_in, n_);
+    Eigen::Map<Eigen::VectorXd> y(y_out, n_);
+    Eigen::VectorXd b = x - z0_ * z0_.dot(x);
+    y.head(n_ - 1) = ldlt_.solve(b.head(n_ - 1));
+    y[n_ - 1] = 0.0;
+    y -= z0_ * z0_.dot(y);
+  }
+
+ private:
+  Eigen::Index n_;
+  Eigen::VectorXd z0_;
+  Eigen::SimplicialLDLT<WeightMatrix> ldlt_;
+};
+
+bool solveSparse(const WeightMatrix& L, const Eigen::VectorXd& z0, const FiedlerOptions& options,
+                 int ncv, Eigen::VectorXd& z) {
+  DeflatedLaplacianInverse op(L, z0);
+  Spectra::SymEigsSolver<DeflatedLaplacianInverse> solver(op, 1, ncv);
+  // A fixed start vector, orthogonal to z0, keeps the result deterministic.
+  Eigen::VectorXd start = Eigen::VectorXd::LinSpaced(L.rows(), 1.0, 2.0);
+  start -= z0 * z0.dot(start);
+  solver.init(start.data());
+  solver.compute(Spectra::SortRule::LargestAlge, options.max_iterations, options.tolerance);
+  if (solver.info() != Spectra::CompInfo::Successful) return false;
+  z = solver.eigenvectors().col(0);
+  return true;
+}
+
+Eigen::VectorXd solveDense(const WeightMatrix& L) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(Eigen::MatrixXd(L), Eigen::ComputeEigenvectors);
+  if (solver.info() != Eigen::Success)
+    throw std::runtime_error("Fiedler vector: the dense eigen solver did not converge");
+  return solver.eigenvectors().col(1);  // eigenvalues ascend: column 1 is the second smallest
+}
+
+/// Fixes the arbitrary sign of an eigenvector: the first component that is
+/// clearly non-zero becomes positive, so that every solver returns the same y.
+void fixSign(Eigen::VectorXd& y) {
+  const double scale = y.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < y.size(); ++i) {
+    if (std::abs(y[i]) > 1e-6 * scale) {
+      if (y[i] < 0) y = -y;
+      return;
+    }
+  }
+}
+
+}  // namespace
+
+FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options) {
+  const Eigen::Index n = W.rows();
+  if (n < 2) throw std::invalid_argument("Fiedler vector: the graph needs at least two nodes");
+  const Eigen::VectorXd d = degrees(W);
+  if (d.minCoeff() <= 0.0)
+    throw std::invalid_argument("Fiedler vector: a node has zero degree (split components first)");
+
+  const Eigen::VectorXd inv_sqrt_d = d.cwiseSqrt().cwiseInverse();
+  const WeightMatrix L = normalizedLaplacian(W, inv_sqrt_d);
+  const Eigen::VectorXd z0 = d.cwiseSqrt().normalized();  // eq. (11): z0 = D^1/2 1
+
+  FiedlerResult result;
+  Eigen::VectorXd z;
+  const bool want_sparse = options.solver == EigenSolver::Sparse ||
+                           (options.solver == EigenSolver::Auto && n > options.dense_max_size);
+  if (want_sparse && n > 2) {
+    const int ncv = static_cast<int>(std::min<Eigen::Index>(n, 20));
+    result.sparse = solveSparse(L, z0, options, ncv, z) ||
+                    solveSparse(L, z0, options, static_cast<int>(std::min<Eigen::Index>(n, 80)), z);
+    result.fell_back = !result.sparse;
+  }
+  if (!result.sparse) {
+    constexpr Eigen::Index kDenseFallbackLimit = 5000;
+    if (result.fell_back && n > kDenseFallbackLimit)
+      throw std::runtime_error("Fiedler vector: Lanczos did not converge on a graph of " +
+                               std::to_string(n) + " nodes, too large for the dense solver");
+    z = solveDense(L);
+  }
+  z.normalize();
+  result.eigenvalue = z.dot(L * z);  // Rayleigh quotient of eq. (8), exact for an eigenvector
+  result.y = inv_sqrt_d.cwiseProduct(z);  // y = D^-1/2 z, eq. (11)
+  fixSign(result.y);
+  return result;
+}
+
+}  // namespace obsgroup
