@@ -1,0 +1,79 @@
+// The PCL-style facade: parameters, poses from VIEWPOINT, results.
+#include "test_support.h"
+
+#include <obsgroup/observation_grouping.h>
+
+#include <gtest/gtest.h>
+
+using namespace obsgroup;
+
+TEST(ObservationGrouping, ParametersRoundTrip) {
+  ObservationGrouping<pcl::PointXYZI> g;
+  EXPECT_DOUBLE_EQ(g.getMatchDistance(), 0.1);
+  EXPECT_DOUBLE_EQ(g.getVoxelLeafSize(), 0.0);
+  EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 1.0);
+  EXPECT_DOUBLE_EQ(g.getDiagonalWeight(), 0.0);
+  EXPECT_EQ(g.getSplitCriterion(), SplitCriterion::Mean);
+  EXPECT_EQ(g.getMinGroupSize(), 1);
+  EXPECT_EQ(g.getNeighbourSearch(), NeighbourSearch::SharedGrid);
+  g.setMatchDistance(0.2);
+  g.setVoxelLeafSize(0.05);
+  g.setNcutThreshold(0.9);
+  g.setDiagonalWeight(1.0);
+  g.setSplitCriterion(SplitCriterion::BestNcut);
+  g.setMinGroupSize(3);
+  g.setMaxDepth(4);
+  g.setNumberOfThreads(1);
+  EXPECT_DOUBLE_EQ(g.getMatchDistance(), 0.2);
+  EXPECT_DOUBLE_EQ(g.getVoxelLeafSize(), 0.05);
+  EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 0.9);
+  EXPECT_DOUBLE_EQ(g.getDiagonalWeight(), 1.0);
+  EXPECT_EQ(g.getSplitCriterion(), SplitCriterion::BestNcut);
+  EXPECT_EQ(g.getMinGroupSize(), 3);
+  EXPECT_EQ(g.getMaxDepth(), 4);
+  EXPECT_EQ(g.getNumberOfThreads(), 1);
+}
+
+TEST(ObservationGrouping, PoseFromViewpointOfAPcdFile) {
+  const auto obs = test::realLog(4);
+  ASSERT_EQ(obs.size(), 4u);
+  // 000003.pcd: VIEWPOINT 0.264964193 -0.233036101 0 0.985235729645 0 0 -0.171203262323
+  const Eigen::Isometry3d& pose = obs[3].pose;
+  EXPECT_NEAR(pose.translation().x(), 0.264964193, 1e-6);
+  EXPECT_NEAR(pose.translation().y(), -0.233036101, 1e-6);
+  const Eigen::Quaterniond q(pose.linear());
+  EXPECT_NEAR(std::abs(q.w()), 0.985235729645, 1e-6);
+  EXPECT_NEAR(std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)), 2 * std::atan2(-0.171203262323, 0.985235729645),
+              1e-6);
+
+  ObservationGrouping<pcl::PointXYZ> g;
+  g.addObservation(obs[3].cloud);  // pose taken from the cloud itself
+  EXPECT_TRUE(g.getObservations()[0].pose.isApprox(pose, 1e-12));
+}
+
+TEST(ObservationGrouping, WeightMatrixHasTheConfiguredDiagonal) {
+  const auto obs = test::simulate<pcl::PointXYZ>(sim::threeRooms(), sim::threeRoomsPoses(2));
+  ObservationGrouping<pcl::PointXYZ> g;
+  for (const auto& o : obs) g.addObservation(o.cloud, o.pose);
+  g.compute();
+  const WeightMatrix& W = g.getWeightMatrix();
+  ASSERT_EQ(W.rows(), 6);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(W.coeff(i, i), 0.0);
+  EXPECT_EQ(W.nonZeros(), 2 * static_cast<Eigen::Index>(g.getOverlap().pairs.size()));
+  EXPECT_TRUE(W.isApprox(WeightMatrix(W.transpose())));
+
+  g.setDiagonalWeight(1.0);  // the paper's reflexive Psi, sec. III
+  const Partition p = g.compute();
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(g.getWeightMatrix().coeff(i, i), 1.0);
+  EXPECT_EQ(p.groups.size(), 6u);  // with a unit diagonal every group falls apart
+
+  g.clear();
+  EXPECT_TRUE(g.getObservations().empty());
+  EXPECT_TRUE(g.compute().groups.empty());
+}
+
+TEST(ObservationGrouping, RejectsNullClouds) {
+  ObservationGrouping<pcl::PointXYZ> g;
+  EXPECT_THROW(g.addObservation(nullptr), std::invalid_argument);
+  EXPECT_THROW(g.addObservation(nullptr, Eigen::Isometry3d::Identity()), std::invalid_argument);
+}

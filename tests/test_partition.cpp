@@ -1,0 +1,174 @@
+// The whole method on maps whose answer is known: the paper's Fig. 3
+// situation, and invariance of the result to the thread count.
+#include "test_support.h"
+
+#include <obsgroup/observation_grouping.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <cstring>
+
+using namespace obsgroup;
+
+namespace {
+
+/// Every observation exactly once, groups ordered by their first member, and
+/// each accepted split's children partition their parent.
+void expectWellFormed(const Partition& p, int n) {
+  std::vector<int> seen(n, 0);
+  int previous_first = -1;
+  for (const auto& g : p.groups) {
+    ASSERT_FALSE(g.empty());
+    EXPECT_TRUE(std::is_sorted(g.begin(), g.end()));
+    EXPECT_GT(g.front(), previous_first);
+    previous_first = g.front();
+    for (int i : g) ++seen[i];
+  }
+  for (int i = 0; i < n; ++i) EXPECT_EQ(seen[i], 1) << "observation " << i;
+  for (const SplitNode& node : p.splits) {
+    if (!node.accepted) {
+      EXPECT_TRUE(node.children.empty());
+      continue;
+    }
+    std::vector<int> united;
+    for (int c : node.children) {
+      EXPECT_EQ(p.splits[c].parent, &node - p.splits.data());
+      united.insert(united.end(), p.splits[c].members.begin(), p.splits[c].members.end());
+    }
+    std::sort(united.begin(), united.end());
+    EXPECT_EQ(united, node.members);
+  }
+}
+
+template <typename PointT>
+Partition groupScans(ObservationGrouping<PointT>& grouping, const std::vector<Observation<PointT>>& obs) {
+  for (const auto& o : obs) grouping.addObservation(o.cloud, o.pose);
+  return grouping.compute();
+}
+
+}  // namespace
+
+TEST(RecursivePartition, ThreeRoomsJoinedByDoorsGiveThreeGroups) {
+  // Fig. 3: scans in three rooms joined by doors are split into the rooms.
+  const auto plan = sim::threeRooms();
+  const auto poses = sim::threeRoomsPoses(5);
+  sim::LaserModel laser;
+  laser.field_of_view = 2 * 3.14159265358979;
+  laser.beams = 360;
+  laser.range_noise = 0.01;
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  const Partition p = groupScans(grouping, test::simulate<pcl::PointXYZ>(plan, poses, laser));
+  expectWellFormed(p, 15);
+  ASSERT_EQ(p.groups.size(), 3u);
+  for (int room = 0; room < 3; ++room) {
+    std::vector<int> expected;
+    for (int k = 0; k < 5; ++k) expected.push_back(room * 5 + k);
+    EXPECT_EQ(p.groups[room], expected);
+    for (int i : expected) EXPECT_EQ(plan.roomAt(poses[i].x, poses[i].y), room);
+  }
+  // The root splits one room off and the rest again, as {G1} and {G2, G3}.
+  ASSERT_EQ(p.splits[0].kind, SplitNode::Kind::Bisection);
+  EXPECT_LT(p.splits[0].ncut, 1.0);
+  EXPECT_EQ(p.splits[0].eigenvector.size(), 15);
+  // Every group's own best split is rejected: Ncut >= 1.
+  for (const SplitNode& node : p.splits) {
+    if (!node.accepted) {
+      EXPECT_GE(node.ncut, 1.0);
+    }
+  }
+}
+
+TEST(RecursivePartition, SimulatedOfficeIsWellFormedForEveryCriterion) {
+  const auto plan = sim::office();
+  const auto obs = test::simulate<pcl::PointXYZ>(plan, sim::officeRoute(77));
+  for (SplitCriterion c : {SplitCriterion::Mean, SplitCriterion::Sign, SplitCriterion::BestNcut}) {
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    grouping.setSplitCriterion(c);
+    const Partition p = groupScans(grouping, obs);
+    expectWellFormed(p, 77);
+    EXPECT_GT(p.groups.size(), 4u) << toString(c);
+    EXPECT_LT(p.groups.size(), 40u) << toString(c);
+  }
+}
+
+TEST(RecursivePartition, ThreadCountDoesNotChangeWOrThePartition) {
+  const auto obs = test::realLog();
+  ASSERT_EQ(obs.size(), 72u);
+  ObservationGrouping<pcl::PointXYZ> one, two;
+  one.setNumberOfThreads(1);
+  two.setNumberOfThreads(2);
+  const Partition a = groupScans(one, obs);
+  const Partition b = groupScans(two, obs);
+  const WeightMatrix& wa = one.getWeightMatrix();
+  const WeightMatrix& wb = two.getWeightMatrix();
+  ASSERT_EQ(wa.nonZeros(), wb.nonZeros());
+  EXPECT_EQ(std::memcmp(wa.valuePtr(), wb.valuePtr(), sizeof(double) * wa.nonZeros()), 0);
+  EXPECT_EQ(std::memcmp(wa.innerIndexPtr(), wb.innerIndexPtr(), sizeof(int) * wa.nonZeros()), 0);
+  EXPECT_EQ(a.groups, b.groups);
+  ASSERT_EQ(a.splits.size(), b.splits.size());
+  for (std::size_t s = 0; s < a.splits.size(); ++s) {
+    EXPECT_EQ(a.splits[s].members, b.splits[s].members);
+    if (a.splits[s].attempted) {
+      EXPECT_EQ(a.splits[s].ncut, b.splits[s].ncut);
+    }
+  }
+  expectWellFormed(a, 72);
+}
+
+namespace {
+
+/// The groups of a `{"observations": N, "groups": [[...], ...]}` file.
+std::vector<std::vector<int>> readGroups(const std::string& path) {
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::vector<int>> groups;
+  std::size_t k = text.find("\"groups\"");
+  if (k == std::string::npos) return groups;
+  int depth = 0;
+  for (k = text.find('[', k); k < text.size(); ++k) {
+    const char c = text[k];
+    if (c == '[' && ++depth == 2) groups.emplace_back();
+    if (c == ']' && --depth == 0) break;
+    if (std::isdigit(static_cast<unsigned char>(c)) && depth == 2) {
+      std::size_t used = 0;
+      groups.back().push_back(std::stoi(text.substr(k), &used));
+      k += used - 1;
+    }
+  }
+  return groups;
+}
+
+}  // namespace
+
+TEST(RecursivePartition, RealOfficeLogRefinesMrptsGroups) {
+  // MRPT's map-partition (delta 0.2, threshold 0.9) finds 6 groups on this log.
+  // Its Ncut counts within-group weight once, so its values are higher than
+  // eq. (1)'s and it splits less: the faithful method finds finer groups that
+  // nest inside MRPT's, up to scans on the boundaries between them.
+  const auto obs = test::realLog();
+  ASSERT_EQ(obs.size(), 72u);
+  const auto mrpt = readGroups(std::string(OBSGROUP_DATA_DIR) + "/real/localization_demo/groups_mrpt.json");
+  ASSERT_EQ(mrpt.size(), 6u);
+  std::vector<int> mrpt_group(72, -1);
+  for (std::size_t g = 0; g < mrpt.size(); ++g)
+    for (int i : mrpt[g]) mrpt_group.at(i) = static_cast<int>(g);
+
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  grouping.setMatchDistance(0.2);
+  const Partition p = groupScans(grouping, obs);
+  expectWellFormed(p, 72);
+  EXPECT_GE(p.groups.size(), mrpt.size());
+  // Purity: the share of scans whose group's majority MRPT group is their own.
+  int agreeing = 0;
+  for (const auto& g : p.groups) {
+    std::vector<int> votes(mrpt.size(), 0);
+    for (int i : g) ++votes[mrpt_group[i]];
+    agreeing += *std::max_element(votes.begin(), votes.end());
+  }
+  EXPECT_GE(agreeing, 0.85 * 72) << agreeing << " of 72 scans agree";
+}

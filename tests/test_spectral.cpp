@@ -1,0 +1,132 @@
+// The Fiedler vector of eq. (10)-(11) and the split criteria of sec. II-A.
+#include <obsgroup/spectral/fiedler_vector.h>
+#include <obsgroup/spectral/spectral_bisection.h>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <random>
+
+using namespace obsgroup;
+
+namespace {
+
+/// A route-like graph: nodes along a path, each linked to its next `reach`
+/// nodes with random weights, and four weak spots where the route passes
+/// doors (what a robot's log gives).
+WeightMatrix routeGraph(int n, int reach, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> weight(0.2, 1.0);
+  std::vector<WeightedPair> pairs;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j <= std::min(n - 1, i + reach); ++j) {
+      double w = weight(rng) / (j - i);
+      if ((i * 5) / n != (j * 5) / n) w *= 0.05;  // a door between five "rooms"
+      pairs.push_back({i, j, w});
+    }
+  return buildWeightMatrix(n, pairs);
+}
+
+double residual(const WeightMatrix& W, const FiedlerResult& f) {
+  // || (D - W) y - lambda D y || / || D y ||, eq. (10)
+  const Eigen::VectorXd d = degrees(W);
+  const Eigen::VectorXd Dy = d.cwiseProduct(f.y);
+  return (Dy - W * f.y - f.eigenvalue * Dy).norm() / Dy.norm();
+}
+
+}  // namespace
+
+TEST(Fiedler, DenseAndSparseAgreeOnAThousandNodes) {
+  const WeightMatrix W = routeGraph(1000, 8, 7);
+  FiedlerOptions dense_options, sparse_options;
+  dense_options.solver = EigenSolver::Dense;
+  sparse_options.solver = EigenSolver::Sparse;
+  const FiedlerResult dense = fiedlerVector(W, dense_options);
+  const FiedlerResult sparse = fiedlerVector(W, sparse_options);
+  EXPECT_FALSE(dense.sparse);
+  EXPECT_TRUE(sparse.sparse);
+  EXPECT_LT(residual(W, dense), 1e-8);
+  EXPECT_LT(residual(W, sparse), 1e-8);
+  EXPECT_NEAR(dense.eigenvalue, sparse.eigenvalue, 1e-10);
+  // Same vector: the sign is fixed by both, so no "up to sign" is needed.
+  EXPECT_LT((dense.y - sparse.y).cwiseAbs().maxCoeff(), 1e-6 * dense.y.cwiseAbs().maxCoeff());
+
+  for (SplitCriterion c : {SplitCriterion::Mean, SplitCriterion::Sign, SplitCriterion::BestNcut}) {
+    const Bisection a = spectralBisection(W, c, dense_options);
+    const Bisection b = spectralBisection(W, c, sparse_options);
+    EXPECT_EQ(a.in_a, b.in_a) << toString(c);
+    EXPECT_NEAR(a.cut.ncut, b.cut.ncut, 1e-12) << toString(c);
+  }
+}
+
+TEST(Fiedler, IsTheSecondSmallestGeneralizedEigenvector) {
+  const WeightMatrix W = routeGraph(60, 4, 3);
+  const FiedlerResult f = fiedlerVector(W, {EigenSolver::Dense});
+  // Reference: the generalized problem (D - W) y = lambda D y solved directly.
+  const Eigen::MatrixXd Wd(W);
+  const Eigen::MatrixXd D = degrees(W).asDiagonal();
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ref(D - Wd, D);
+  EXPECT_NEAR(f.eigenvalue, ref.eigenvalues()[1], 1e-12);
+  EXPECT_NEAR(ref.eigenvalues()[0], 0.0, 1e-12);
+  Eigen::VectorXd y = ref.eigenvectors().col(1);
+  y *= f.y.norm() / y.norm();
+  if (y.dot(f.y) < 0) y = -y;
+  EXPECT_LT((y - f.y).norm(), 1e-8 * y.norm());
+  // y is D-orthogonal to y_0 = 1 (sec. II-A).
+  EXPECT_NEAR(degrees(W).dot(f.y), 0.0, 1e-10);
+}
+
+TEST(Fiedler, RejectsGraphsItCannotSolve) {
+  EXPECT_THROW(fiedlerVector(buildWeightMatrix(1, {})), std::invalid_argument);
+  EXPECT_THROW(fiedlerVector(buildWeightMatrix(3, {{0, 1, 1.0}})), std::invalid_argument);
+}
+
+TEST(Fiedler, AutoUsesSparseAboveTheThreshold) {
+  const WeightMatrix W = routeGraph(300, 5, 11);
+  FiedlerOptions options;
+  options.dense_max_size = 299;
+  EXPECT_TRUE(fiedlerVector(W, options).sparse);
+  options.dense_max_size = 300;
+  EXPECT_FALSE(fiedlerVector(W, options).sparse);
+}
+
+TEST(SpectralBisection, BestNcutIsTheMinimumOverAllThresholds) {
+  const WeightMatrix W = routeGraph(200, 6, 5);
+  const Bisection best = spectralBisection(W, SplitCriterion::BestNcut);
+  // Brute force: every threshold between consecutive sorted values of y.
+  std::vector<double> values(best.fiedler.y.data(), best.fiedler.y.data() + best.fiedler.y.size());
+  std::sort(values.begin(), values.end());
+  double minimum = 2.0;
+  for (std::size_t k = 0; k + 1 < values.size(); ++k) {
+    std::vector<bool> in_a(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) in_a[i] = best.fiedler.y[i] > values[k];
+    minimum = std::min(minimum, normalizedCut(W, in_a).ncut);
+  }
+  EXPECT_NEAR(best.cut.ncut, minimum, 1e-12);
+  EXPECT_LE(best.cut.ncut, spectralBisection(W, SplitCriterion::Mean).cut.ncut + 1e-15);
+  EXPECT_LE(best.cut.ncut, spectralBisection(W, SplitCriterion::Sign).cut.ncut + 1e-15);
+}
+
+TEST(SpectralBisection, CriteriaUseTheirThresholds) {
+  const WeightMatrix W = routeGraph(100, 4, 9);
+  const Bisection mean = spectralBisection(W, SplitCriterion::Mean);
+  const Bisection sign = spectralBisection(W, SplitCriterion::Sign);
+  EXPECT_DOUBLE_EQ(mean.threshold, mean.fiedler.y.mean());
+  EXPECT_EQ(sign.threshold, 0.0);
+  for (Eigen::Index i = 0; i < W.rows(); ++i) {
+    EXPECT_EQ(mean.in_a[i], mean.fiedler.y[i] > mean.threshold);
+    EXPECT_EQ(sign.in_a[i], sign.fiedler.y[i] > 0.0);
+  }
+  EXPECT_EQ(splitCriterionFromString("best"), SplitCriterion::BestNcut);
+  EXPECT_THROW(splitCriterionFromString("median"), std::invalid_argument);
+}
+
+TEST(SpectralBisection, BestNcutHonoursTheMinimumSide) {
+  const WeightMatrix W = routeGraph(100, 4, 9);
+  const Bisection b = spectralBisection(W, SplitCriterion::BestNcut, {}, 45);
+  const auto size_a = std::count(b.in_a.begin(), b.in_a.end(), true);
+  EXPECT_GE(size_a, 45);
+  EXPECT_LE(size_a, 55);
+}
