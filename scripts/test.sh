@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Builds obsgroup in Release (tests and examples included) and runs the
+# whole test suite.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$(nproc)"
+ctest --test-dir build --output-on-failure -j"$(nproc)"
