@@ -2,7 +2,7 @@
 // 180-degree laser, as in the paper's Fig. 5) and prints the groups, the room
 // each scan was taken in, and the split tree with its normalized cuts.
 //
-//   partition_synthetic [--scans N] [--delta METRES] [--split mean|sign|best]
+//   partition_synthetic [--scans N] [--delta METRES] [--split mean|sign|best] [--diagonal W_II]
 
 #include "floor_plan.h"
 #include "to_cloud.h"
@@ -21,7 +21,7 @@
 namespace {
 
 void usage(const char* argv0) {
-  std::cerr << "usage: " << argv0 << " [--scans N] [--delta METRES] [--split mean|sign|best]\n";
+  std::cerr << "usage: " << argv0 << " [--scans N] [--delta METRES] [--split mean|sign|best] [--diagonal W_II]\n";
 }
 
 }  // namespace
@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   int scans = 77;
   double delta = 0.1;
   std::string split = "mean";
+  double diagonal = obsgroup::kDefaultDiagonalWeight;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (a + 1 >= argc) {
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
       if (arg == "--scans") scans = std::stoi(argv[++a]);
       else if (arg == "--delta") delta = std::stod(argv[++a]);
       else if (arg == "--split") split = argv[++a];
+      else if (arg == "--diagonal") diagonal = std::stod(argv[++a]);
       else {
         usage(argv[0]);
         return 2;
@@ -51,6 +53,10 @@ int main(int argc, char** argv) {
   }
   if (scans < 1) {
     std::cerr << "error: option --scans: must be at least 1\n";
+    return 2;
+  }
+  if (!(delta > 0) || !(diagonal >= 0)) {
+    std::cerr << "error: --delta must be > 0 and --diagonal >= 0\n";
     return 2;
   }
 
@@ -66,6 +72,7 @@ int main(int argc, char** argv) {
     grouping.addObservation(obsgroup::sim::toCloud<pcl::PointXYZ>(points), obsgroup::pose2D(pose.x, pose.y, pose.yaw));
   }
   grouping.setMatchDistance(delta);
+  grouping.setDiagonalWeight(diagonal);
   try {
     grouping.setSplitCriterion(obsgroup::splitCriterionFromString(split));
   } catch (const std::exception& e) {
@@ -77,8 +84,8 @@ int main(int argc, char** argv) {
   const obsgroup::Partition partition = grouping.compute();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  std::printf("%zu scans of a simulated office, delta %.3g m, split '%s': %zu groups in %.3f s\n\n",
-              route.size(), delta, split.c_str(), partition.groups.size(), seconds);
+  std::printf("%zu scans of a simulated office, delta %.3g m, split '%s', W_ii = %g: %zu groups in %.3f s\n\n",
+              route.size(), delta, split.c_str(), diagonal, partition.groups.size(), seconds);
   for (std::size_t g = 0; g < partition.groups.size(); ++g) {
     std::map<std::string, int> rooms;
     for (int i : partition.groups[g]) {
