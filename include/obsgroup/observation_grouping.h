@@ -13,6 +13,13 @@
 
 namespace obsgroup {
 
+/// Wall time of each stage of the last ObservationGrouping::compute().
+struct GroupingTimings {
+  double overlap_s = 0.0;    ///< filtering, world frame, Pi and Psi (eq. 16-18)
+  double graph_s = 0.0;      ///< building W
+  double partition_s = 0.0;  ///< recursive spectral bisection (sec. II)
+};
+
 /// Groups observations into consistent local maps (Blanco, Gonzalez,
 /// Fernandez-Madrigal, ICRA 2006): W_ij = Psi(n_i, n_j) (eq. 18), then
 /// recursive spectral bisection by minimum normalized cut (sec. II).
@@ -52,6 +59,7 @@ class ObservationGrouping {
   SearchMethodPtr getSearchMethod() const { return overlap_.getSearchMethod(); }
   void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
   int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
+  void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
 
   // --- graph and partition (sec. II, III) ---
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
@@ -78,6 +86,8 @@ class ObservationGrouping {
   const WeightMatrix& getWeightMatrix() const { return W_; }
   /// Pi, Psi and work statistics of the last compute().
   const OverlapResult& getOverlap() const { return overlap_result_; }
+  /// Time spent in each stage of the last compute().
+  const GroupingTimings& getTimings() const { return timings_; }
 
  private:
   std::vector<Observation<PointT>> observations_;
@@ -86,6 +96,7 @@ class ObservationGrouping {
   PartitionOptions options_;
   OverlapResult overlap_result_;
   WeightMatrix W_;
+  GroupingTimings timings_;
 };
 
 }  // namespace obsgroup

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -219,7 +220,8 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, double delta_sq
 
 }  // namespace
 
-MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads) {
+MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads,
+                                   const ProgressCallback& progress) {
   if (!(delta > 0.0) || !std::isfinite(delta))
     throw std::invalid_argument("shared grid: the match distance delta must be finite and > 0");
   const int n = world.size();
@@ -230,16 +232,22 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   const double delta_sq = delta * delta;
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
   std::uint64_t pairs = 0, tests = 0;
+  std::atomic<std::size_t> done{0};
   // Every point's cell was computed (and range-checked) when the grid was
   // built, so nothing below can throw inside the parallel region.
 #pragma omp parallel num_threads(nthreads) reduction(+ : pairs, tests)
   {
     RowScratch scratch(n);
 #pragma omp for schedule(dynamic, 8)
-    for (int i = 0; i < n; ++i) countRow(grid, world, i, delta_sq, scratch, out.rows[i]);
+    for (int i = 0; i < n; ++i) {
+      countRow(grid, world, i, delta_sq, scratch, out.rows[i]);
+      const std::size_t now = ++done;
+      if (progress && omp_get_thread_num() == 0) progress(now, n);
+    }
     pairs += scratch.pairs;
     tests += scratch.tests;
   }
+  if (progress) progress(n, n);
   out.pairs_evaluated = pairs;
   out.point_tests = tests;
   return out;

@@ -2,6 +2,7 @@
 
 #include "obsgroup/observation_grouping.h"
 
+#include <chrono>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -27,9 +28,20 @@ void ObservationGrouping<PointT>::clear() {
 
 template <typename PointT>
 Partition ObservationGrouping<PointT>::compute() {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  auto start = Clock::now();
   overlap_result_ = overlap_.compute(observations_);
+  timings_.overlap_s = seconds_since(start);
+  start = Clock::now();
   W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, diagonal_);
-  return recursivePartition(W_, options_);
+  timings_.graph_s = seconds_since(start);
+  start = Clock::now();
+  Partition partition = recursivePartition(W_, options_);
+  timings_.partition_s = seconds_since(start);
+  return partition;
 }
 
 }  // namespace obsgroup

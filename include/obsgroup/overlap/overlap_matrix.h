@@ -6,6 +6,7 @@
 #include "obsgroup/overlap/world_points.h"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace obsgroup {
@@ -16,6 +17,10 @@ struct MatchCount {
   int j = 0;
   std::uint32_t count = 0;
 };
+
+/// Progress of a long stage: called with the number of observations done and
+/// the total, from one thread at a time, the last call with done == total.
+using ProgressCallback = std::function<void(std::size_t done, std::size_t total)>;
 
 /// Output of a neighbour back-end: for each observation i, the observations it
 /// matched (ascending j, count > 0), plus work statistics.

@@ -63,6 +63,10 @@ class SensedSpaceOverlap {
   void setNumberOfThreads(int threads) { threads_ = threads; }
   int getNumberOfThreads() const { return threads_; }
 
+  /// Called as observations are matched (the overlap stage can take minutes
+  /// on big logs); empty by default.
+  void setProgressCallback(ProgressCallback callback) { progress_ = std::move(callback); }
+
   /// Filters and moves every observation to the common frame. Throws
   /// std::invalid_argument on a null cloud, a non-finite pose or a voxel
   /// leaf too small for a cloud's extent.
@@ -81,6 +85,7 @@ class SensedSpaceOverlap {
   NeighbourSearch neighbour_search_ = NeighbourSearch::SharedGrid;
   SearchMethodPtr search_;
   int threads_ = 0;
+  ProgressCallback progress_;
 };
 
 }  // namespace obsgroup

@@ -17,6 +17,7 @@ namespace obsgroup {
 /// point is tested against the 3x3 (flat data) or 3x3x3 neighbouring cells,
 /// and each nearby observation is counted at most once per point. Rows are
 /// independent, so the result is the same for any number of threads.
-MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0);
+MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0,
+                                   const ProgressCallback& progress = {});
 
 }  // namespace obsgroup

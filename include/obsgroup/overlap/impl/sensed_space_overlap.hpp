@@ -9,6 +9,7 @@
 
 #include <omp.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -90,58 +91,78 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
   return world;
 }
 
+namespace detail {
+
+/// Column j of the PCL-search back-end: for each candidate i, the number of
+/// i's points with a point of j within delta. The search runs in float, so it
+/// is asked a slightly larger radius and the match decided by the predicate
+/// shared with the grid back-end.
+template <typename PointT>
+std::vector<MatchCount> countColumnPclSearch(pcl::search::Search<PointT>& search, const WorldPoints& world, int j,
+                                             const std::vector<int>& candidates, double delta,
+                                             std::uint64_t& tests) {
+  typename pcl::PointCloud<PointT>::Ptr target(new pcl::PointCloud<PointT>);
+  target->resize(world.count(j));
+  for (std::size_t k = 0; k < world.count(j); ++k) {
+    const Eigen::Vector3f& q = world.begin(j)[k];
+    (*target)[k].x = q.x();
+    (*target)[k].y = q.y();
+    (*target)[k].z = q.z();
+  }
+  search.setInputCloud(target);
+  const double delta_sq = delta * delta;
+  const double radius = delta * (1.0 + 1e-5);
+  pcl::Indices indices;
+  std::vector<float> sq_distances;
+  std::vector<MatchCount> column;  // (i, count): MatchCount::j holds i here
+  for (int i : candidates) {
+    std::uint32_t count = 0;
+    PointT query;
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+      ++tests;
+      query.x = p->x();
+      query.y = p->y();
+      query.z = p->z();
+      // The nearest neighbour decides, unless float rounding put it just
+      // outside delta: then every neighbour in the radius is checked.
+      if (search.radiusSearch(query, radius, indices, sq_distances, 1) == 0) continue;
+      bool match = withinMatchDistance(*p, world.begin(j)[indices[0]], delta_sq);
+      if (!match) {
+        search.radiusSearch(query, radius, indices, sq_distances, 0);
+        for (const auto k : indices) match = match || withinMatchDistance(*p, world.begin(j)[k], delta_sq);
+      }
+      count += match;
+    }
+    if (count > 0) column.push_back({i, count});
+  }
+  return column;
+}
+
+}  // namespace detail
+
 template <typename PointT>
 MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints& world) const {
   const int n = world.size();
   const auto candidates = overlappingBoxes(world, delta_);
-  const double delta_sq = delta_ * delta_;
-  // The search runs in float: ask a slightly larger radius, then decide with
-  // the exact predicate shared with the grid back-end.
-  const double radius = delta_ * (1.0 + 1e-5);
-  std::vector<std::vector<MatchCount>> columns(n);  // columns[j]: (i, count) with i ascending
+  std::vector<std::vector<MatchCount>> columns(n);
   std::uint64_t pairs = 0, tests = 0;
+  std::atomic<std::size_t> done{0};
+  // A user's search object is shared, so it runs on one thread; otherwise
+  // each thread owns a kd-tree.
   const int threads = search_ ? 1 : (threads_ > 0 ? threads_ : omp_get_max_threads());
-
 #pragma omp parallel num_threads(threads) reduction(+ : pairs, tests)
   {
     SearchMethodPtr search = search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false));
-    pcl::Indices indices;
-    std::vector<float> sq_distances;
 #pragma omp for schedule(dynamic, 4)
     for (int j = 0; j < n; ++j) {
-      if (candidates[j].empty()) continue;
-      typename PointCloud::Ptr target(new PointCloud);
-      target->resize(world.count(j));
-      for (std::size_t k = 0; k < world.count(j); ++k) {
-        const Eigen::Vector3f& q = world.begin(j)[k];
-        (*target)[k].x = q.x();
-        (*target)[k].y = q.y();
-        (*target)[k].z = q.z();
-      }
-      search->setInputCloud(target);
-      for (int i : candidates[j]) {
-        ++pairs;
-        std::uint32_t count = 0;
-        PointT query;
-        for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
-          ++tests;
-          query.x = p->x();
-          query.y = p->y();
-          query.z = p->z();
-          // The nearest neighbour decides, unless float rounding put it just
-          // outside delta: then every neighbour in the radius is checked.
-          if (search->radiusSearch(query, radius, indices, sq_distances, 1) == 0) continue;
-          bool match = withinMatchDistance(*p, world.begin(j)[indices[0]], delta_sq);
-          if (!match) {
-            search->radiusSearch(query, radius, indices, sq_distances, 0);
-            for (const auto k : indices) match = match || withinMatchDistance(*p, world.begin(j)[k], delta_sq);
-          }
-          count += match;
-        }
-        if (count > 0) columns[j].push_back({i, count});
-      }
+      if (!candidates[j].empty())
+        columns[j] = detail::countColumnPclSearch(*search, world, j, candidates[j], delta_, tests);
+      pairs += candidates[j].size();
+      const std::size_t now = ++done;
+      if (progress_ && omp_get_thread_num() == 0) progress_(now, n);
     }
   }
+  if (progress_) progress_(n, n);
 
   MatchCounts out;
   out.rows.resize(n);
@@ -158,7 +179,7 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
     throw std::invalid_argument("match distance delta must be finite and > 0");
   const WorldPoints world = toWorld(observations);
   const MatchCounts counts = neighbour_search_ == NeighbourSearch::SharedGrid
-                                 ? countMatchesSharedGrid(world, delta_, threads_)
+                                 ? countMatchesSharedGrid(world, delta_, threads_, progress_)
                                  : countMatchesPclSearch(world);
   return assembleOverlap(counts, world);
 }
