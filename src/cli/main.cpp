@@ -1,0 +1,121 @@
+// obsgroup: group robot observations into consistent local maps and a
+// metric-topological map (Blanco, Gonzalez, Fernandez-Madrigal, ICRA 2006).
+//
+// Exit codes: 0 done, 2 usage error, 3 input error, 1 anything else.
+
+#include "errors.h"
+#include "partition_command.h"
+
+#include <CLI/CLI.hpp>
+#include <pcl/console/print.h>
+
+#include <cstdio>
+#include <map>
+
+namespace {
+
+void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, double& fov, double& max_range,
+                         std::string& poses, int& max_depth, double& map_voxel) {
+  using obsgroup::SplitCriterion;
+  using obsgroup::io::LaserSource;
+  using obsgroup::io::PoseFormat;
+  command.add_option("input", args.input, "CARMEN log (.clf, .log, .gfs.log) or folder of .pcd files")->required();
+  command.add_option("-o,--output", args.output, "folder to write the results to")->required();
+  command.add_option("--format", args.format, "input format (default: from the input)")
+      ->check(CLI::IsMember({"auto", "carmen", "pcd"}));
+
+  const std::map<std::string, LaserSource> lasers{
+      {"front", LaserSource::Front}, {"rear", LaserSource::Rear}, {"robotlaser", LaserSource::RobotLaser}};
+  command.add_option("--laser", args.laser, "CARMEN: which laser messages (FLASER, RLASER, ROBOTLASER1)")
+      ->transform(CLI::CheckedTransformer(lasers))
+      ->group("CARMEN logs");
+  command.add_option("--fov", fov, "CARMEN: field of view of FLASER/RLASER scans, degrees (default: PARAM, else 180)")
+      ->check(CLI::Range(1.0, 360.0))
+      ->group("CARMEN logs");
+  command.add_option("--max-range", max_range, "CARMEN: readings at or beyond this are no return, metres")
+      ->check(CLI::PositiveNumber)
+      ->group("CARMEN logs");
+
+  command.add_option("--poses", poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
+      ->group("PCD sequences");
+  const std::map<std::string, PoseFormat> formats{{"tum", PoseFormat::Tum}, {"kitti", PoseFormat::Kitti}};
+  command.add_option("--pose-format", args.pose_format, "PCD: format of --poses")
+      ->transform(CLI::CheckedTransformer(formats))
+      ->group("PCD sequences");
+
+  command.add_option("--delta", args.delta, "match distance of eq. (16), metres")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--voxel", args.voxel, "voxel downsampling leaf before matching, metres (0 = off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--ncut-threshold", args.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
+      ->check(CLI::Range(0.0, 2.0))
+      ->capture_default_str()
+      ->group("Method");
+  const std::map<std::string, SplitCriterion> splits{
+      {"mean", SplitCriterion::Mean}, {"sign", SplitCriterion::Sign}, {"best", SplitCriterion::BestNcut}};
+  command.add_option("--split", args.split, "how the eigenvector is cut: mean (the paper's), sign or best")
+      ->transform(CLI::CheckedTransformer(splits))
+      ->group("Method");
+  command.add_option("--min-group-size", args.min_group_size, "reject a bisection giving a smaller group")
+      ->check(CLI::Range(1, 1 << 30))
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--max-depth", max_depth, "do not bisect deeper than this (default: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->group("Method");
+  command.add_option("--threads", args.threads, "threads (0 = all cores); results do not depend on it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command.add_option("--map-voxel", map_voxel, "voxel leaf of the local maps written, metres (default: delta/2)")
+      ->check(CLI::NonNegativeNumber);
+  command.add_flag("--force", args.force, "replace the results already in the output folder");
+  command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr");
+  command.add_flag("!--no-pictures", args.pictures, "do not draw map.png/.svg, weights.png, fiedler.png");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // obsgroup words its own errors
+
+  CLI::App app{"obsgroup: group robot observations into consistent local maps and a metric-topological map"};
+  app.set_version_flag("--version", "obsgroup 0.1.0");
+  app.require_subcommand(1, 1);
+  obsgroup::cli::PartitionArgs args;
+  double fov = 0.0, max_range = 0.0, map_voxel = 0.0;
+  std::string poses;
+  int max_depth = 0;
+  CLI::App* partition = app.add_subcommand("partition", "group the observations of a log or a PCD sequence");
+  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+  if (partition->count("--fov")) args.field_of_view_deg = fov;
+  if (partition->count("--max-range")) args.max_range = max_range;
+  if (partition->count("--poses")) args.poses = poses;
+  if (partition->count("--max-depth")) args.max_depth = max_depth;
+  if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
+
+  try {
+    return obsgroup::cli::runPartition(args);
+  } catch (const obsgroup::io::UsageError& e) {
+    std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
+    return 2;
+  } catch (const obsgroup::io::InputError& e) {
+    std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
+    return 1;
+  }
+}

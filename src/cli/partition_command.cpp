@@ -1,0 +1,209 @@
+#include "partition_command.h"
+
+#include "errors.h"
+#include "local_maps.h"
+#include "output_folder.h"
+#include "pcd_sequence.h"
+#include "pictures.h"
+#include "progress_bar.h"
+#include "result_writers.h"
+
+#include <obsgroup/maps/topological_map.h>
+#include <obsgroup/observation_grouping.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+namespace obsgroup::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// What reading the input gave, besides the observations.
+struct InputRecord {
+  std::string format;          ///< "carmen" or "pcd"
+  nlohmann::json parameters;   ///< reader settings actually used
+  std::vector<std::string> labels;  ///< where each observation came from, for messages
+  std::vector<std::string> warnings;
+  double load_s = 0.0;
+};
+
+std::string detectFormat(const PartitionArgs& args) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(args.input, ec)) throw io::InputError(args.input + ": no such file or folder");
+  const bool folder = fs::is_directory(args.input, ec);
+  if (args.format == "pcd" && !folder)
+    throw io::UsageError(args.input + ": --format pcd needs a folder of .pcd files");
+  if (args.format == "carmen" && folder) throw io::UsageError(args.input + ": --format carmen needs a log file");
+  if (args.format != "auto") return args.format;
+  if (folder) return "pcd";
+  if (fs::path(args.input).extension() == ".pcd")
+    throw io::UsageError(args.input + ": a single PCD file; give the folder holding the sequence");
+  return "carmen";
+}
+
+void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
+  if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences only");
+  if (format == "pcd" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
+    throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
+}
+
+nlohmann::json optional(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json();
+}
+
+void warn(const PartitionArgs& args, const std::string& message) {
+  if (!args.quiet) std::fprintf(stderr, "obsgroup: warning: %s\n", message.c_str());
+}
+
+template <typename PointT>
+int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
+  for (const auto& w : input.warnings) warn(args, w);
+  for (std::size_t i = 0; i < observations.size(); ++i)
+    if (observations[i].cloud->empty()) warn(args, input.labels[i] + ": no point; kept as a group of its own");
+
+  ObservationGrouping<PointT> grouping;
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  grouping.setMatchDistance(args.delta);
+  grouping.setVoxelLeafSize(args.voxel);
+  grouping.setNcutThreshold(args.ncut_threshold);
+  grouping.setSplitCriterion(args.split);
+  grouping.setMinGroupSize(args.min_group_size);
+  if (args.max_depth) grouping.setMaxDepth(*args.max_depth);
+  grouping.setNumberOfThreads(args.threads);
+  ProgressBar bar("overlap", !args.quiet);
+  grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
+  Partition partition;
+  try {
+    partition = grouping.compute();
+  } catch (const std::invalid_argument& e) {
+    throw io::InputError(args.input + ": " + e.what());
+  }
+  bar.finish();
+
+  const auto outputs_start = Clock::now();
+  const io::OutputFolder out(args.output, args.force);
+  std::vector<Eigen::Isometry3d> poses;
+  for (const auto& o : observations) poses.push_back(o.pose);
+  const TopologicalMap topology = buildTopologicalMap(partition, grouping.getWeightMatrix(), poses);
+  const double map_voxel = args.map_voxel.value_or(args.delta / 2);
+  std::vector<std::string> warnings;
+  const std::size_t map_points = io::writeLocalMaps(out, observations, partition, map_voxel, warnings);
+  for (const auto& w : warnings) warn(args, w);
+  out.writeText("topology.json", io::topologyJson(topology));
+  out.writeText("topology.dot", io::topologyDot(topology));
+  if (args.pictures) {
+    SensedSpaceOverlap<PointT> world_frame;
+    world_frame.setVoxelLeafSize(args.voxel);
+    world_frame.setNumberOfThreads(args.threads);
+    io::writeMapPictures(out, world_frame.toWorld(observations), poses, partition, topology);
+    io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
+    io::writeFiedlerPicture(out, partition);
+  }
+  const double outputs_s = secondsSince(outputs_start);
+
+  const auto& overlap = grouping.getOverlap();
+  std::size_t points = 0;
+  for (std::size_t m : overlap.points_per_observation) points += m;
+  io::RunRecord run;
+  run.input = args.input;
+  run.parameters = input.parameters;
+  run.parameters["format"] = input.format;
+  run.parameters["delta"] = args.delta;
+  run.parameters["voxel"] = args.voxel;
+  run.parameters["ncut_threshold"] = args.ncut_threshold;
+  run.parameters["split"] = toString(args.split);
+  run.parameters["min_group_size"] = args.min_group_size;
+  run.parameters["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
+  run.parameters["diagonal"] = grouping.getDiagonalWeight();
+  run.parameters["neighbour_search"] = "shared_grid";
+  run.parameters["map_voxel"] = map_voxel;
+  run.statistics = {{"points", points},
+                    {"pairs_evaluated", overlap.pairs_evaluated},
+                    {"point_tests", overlap.point_tests},
+                    {"edges", overlap.pairs.size()},
+                    {"groups", partition.groups.size()},
+                    {"local_map_points", map_points}};
+  const auto& t = grouping.getTimings();
+  run.timing_s = {{"load", input.load_s}, {"overlap", t.overlap_s}, {"graph", t.graph_s},
+                  {"partition", t.partition_s}, {"outputs", outputs_s}, {"threads", args.threads}};
+  // partition.json last: its presence marks a complete run.
+  out.writeText("partition.json", io::partitionJson(partition, run));
+
+  if (!args.quiet) {
+    std::fprintf(stderr,
+                 "obsgroup: %zu observations (%zu points), %llu pairs evaluated, %zu overlapping, %zu groups\n"
+                 "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, outputs %.2f s\n"
+                 "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
+                 observations.size(), points, static_cast<unsigned long long>(overlap.pairs_evaluated),
+                 overlap.pairs.size(), partition.groups.size(), input.load_s, t.overlap_s, t.graph_s,
+                 t.partition_s, outputs_s, args.output.c_str(),
+                 args.pictures ? ", map.png/.svg, weights.png, fiedler.png" : "");
+  }
+  return 0;
+}
+
+int runCarmen(const PartitionArgs& args) {
+  const auto start = Clock::now();
+  io::CarmenOptions options;
+  options.laser = args.laser;
+  options.field_of_view_deg = args.field_of_view_deg;
+  options.max_range = args.max_range;
+  io::CarmenLog log = io::readCarmenLog(args.input, options);
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  InputRecord input;
+  input.format = "carmen";
+  for (const auto& scan : log.scans) {
+    observations.push_back({io::scanToCloud(scan), scan.laser_pose});
+    input.labels.push_back(args.input + ":" + std::to_string(scan.line));
+  }
+  input.parameters = {{"laser", io::toString(log.source)},
+                      {"fov_deg", optional(args.field_of_view_deg)},
+                      {"max_range", optional(args.max_range)},
+                      {"point_type", io::toString(io::PointKind::XYZ)}};
+  input.warnings = std::move(log.warnings);
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(observations), std::move(input));
+}
+
+template <typename PointT>
+int runPcd(const PartitionArgs& args, const std::vector<std::string>& files, io::PointKind kind,
+           Clock::time_point start) {
+  std::optional<std::vector<Eigen::Isometry3d>> poses;
+  if (args.poses) poses = io::readPoses(*args.poses, args.pose_format);
+  io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""));
+  InputRecord input;
+  input.format = "pcd";
+  input.labels = files;
+  input.parameters = {{"poses", args.poses ? nlohmann::json(*args.poses) : nlohmann::json("VIEWPOINT")},
+                      {"pose_format", args.poses ? nlohmann::json(io::toString(args.pose_format)) : nlohmann::json()},
+                      {"point_type", io::toString(kind)}};
+  input.warnings = std::move(sequence.warnings);
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(sequence.observations), std::move(input));
+}
+
+}  // namespace
+
+int runPartition(const PartitionArgs& args) {
+  const std::string format = detectFormat(args);
+  checkOptionsFit(args, format);
+  io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
+  if (format == "carmen") return runCarmen(args);
+
+  const auto start = Clock::now();
+  const auto files = io::listPcdFiles(args.input);
+  switch (const io::PointKind kind = io::detectPointKind(files.front())) {
+    case io::PointKind::XYZI: return runPcd<pcl::PointXYZI>(args, files, kind, start);
+    case io::PointKind::XYZRGB: return runPcd<pcl::PointXYZRGB>(args, files, kind, start);
+    case io::PointKind::XYZ: break;
+  }
+  return runPcd<pcl::PointXYZ>(args, files, io::PointKind::XYZ, start);
+}
+
+}  // namespace obsgroup::cli

@@ -1,0 +1,45 @@
+#pragma once
+// `obsgroup partition INPUT -o OUTDIR`: read a log or a PCD sequence, group
+// its observations and write the results.
+
+#include "carmen_reader.h"
+#include "pose_file.h"
+
+#include <obsgroup/spectral/spectral_bisection.h>
+
+#include <optional>
+#include <string>
+
+namespace obsgroup::cli {
+
+struct PartitionArgs {
+  std::string input;
+  std::string output;
+  std::string format = "auto";  ///< auto, carmen or pcd
+  // CARMEN logs
+  io::LaserSource laser = io::LaserSource::Auto;
+  std::optional<double> field_of_view_deg;
+  std::optional<double> max_range;
+  // PCD sequences
+  std::optional<std::string> poses;
+  io::PoseFormat pose_format = io::PoseFormat::Tum;
+  // the method
+  double delta = 0.1;
+  double voxel = 0.0;
+  double ncut_threshold = 1.0;
+  SplitCriterion split = SplitCriterion::Mean;
+  int min_group_size = 1;
+  std::optional<int> max_depth;
+  int threads = 0;
+  std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
+  // the run
+  bool force = false;
+  bool quiet = false;
+  bool pictures = true;
+};
+
+/// Runs the command; returns the exit code. Throws io::UsageError (exit 2)
+/// and io::InputError (exit 3).
+int runPartition(const PartitionArgs& args);
+
+}  // namespace obsgroup::cli

@@ -1,0 +1,251 @@
+#include "carmen_reader.h"
+
+#include "errors.h"
+#include "text_fields.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+namespace obsgroup::io {
+
+std::string toString(LaserSource source) {
+  switch (source) {
+    case LaserSource::Auto: return "auto";
+    case LaserSource::Front: return "front";
+    case LaserSource::Rear: return "rear";
+    case LaserSource::RobotLaser: return "robotlaser";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDefaultFieldOfViewDeg = 180.0;
+constexpr double kDefaultMaxRange = 80.0;  // SICK scanners report ~81.9 m for "no return"
+constexpr long kMaxReadings = 1000000;
+
+const char* messageName(LaserSource source) {
+  switch (source) {
+    case LaserSource::Front: return "FLASER";
+    case LaserSource::Rear: return "RLASER";
+    case LaserSource::RobotLaser: return "ROBOTLASER1";
+    case LaserSource::Auto: break;
+  }
+  return "";
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file");
+  std::ostringstream content;
+  content << in.rdbuf();
+  return content.str();
+}
+
+/// Checks that a message line has exactly `expected` fields; otherwise names
+/// the first missing field, or says the counts do not match.
+void requireFieldCount(const std::vector<std::string_view>& fields, std::size_t expected, const LineRef& where,
+                       const std::string& counts, const std::function<std::string(std::size_t)>& field_name) {
+  const std::string message(fields[0]);
+  if (fields.size() < expected)
+    throw inputError(where.file, where.line,
+                     message + " line is truncated: it has " + std::to_string(fields.size()) +
+                         " fields and ends before field '" + field_name(fields.size()) + "' (" + counts +
+                         " make " + std::to_string(expected) + " fields)");
+  if (fields.size() > expected)
+    throw inputError(where.file, where.line,
+                     message + " line has " + std::to_string(fields.size()) + " fields, but " + counts + " make " +
+                         std::to_string(expected) + ": the number of ranges does not match");
+}
+
+void readRanges(const std::vector<std::string_view>& fields, std::size_t first, long n, const LineRef& where,
+                LaserScan& scan) {
+  scan.ranges.resize(n);
+  for (long k = 0; k < n; ++k)
+    scan.ranges[k] = parseDouble(fields[first + k], where, "range " + std::to_string(k + 1));  // nan/inf: no return
+}
+
+Eigen::Isometry3d parsePose(const std::vector<std::string_view>& fields, std::size_t first, const LineRef& where,
+                            const std::string& prefix) {
+  const double x = parseFinite(fields[first], where, prefix + "_x");
+  const double y = parseFinite(fields[first + 1], where, prefix + "_y");
+  const double theta = parseFinite(fields[first + 2], where, prefix + "_theta");
+  return pose2D(x, y, theta);
+}
+
+/// FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
+LaserScan parseFrontOrRearLaser(const std::vector<std::string_view>& fields, const LineRef& where) {
+  static const char* kTail[] = {"x", "y", "theta", "odom_x", "odom_y", "odom_theta",
+                                "ipc_timestamp", "ipc_hostname", "logger_timestamp"};
+  if (fields.size() < 2)
+    throw inputError(where.file, where.line, std::string(fields[0]) + " line ends before field 'num_readings'");
+  const long n = parseCount(fields[1], where, "num_readings", kMaxReadings);
+  requireFieldCount(fields, 2 + n + 9, where, "num_readings = " + std::to_string(n), [n](std::size_t k) {
+    return k < std::size_t(2 + n) ? "range " + std::to_string(k - 1) : std::string(kTail[k - 2 - n]);
+  });
+  LaserScan scan;
+  readRanges(fields, 2, n, where, scan);
+  scan.laser_pose = parsePose(fields, 2 + n, where, "laser_pose");  // x y theta: the laser's pose
+  return scan;
+}
+
+/// ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy
+/// remission_mode n r1..rn num_remissions [remissions] laser_pose_x laser_pose_y laser_pose_theta
+/// robot_pose_x robot_pose_y robot_pose_theta laser_tv laser_rv forward_safety_dist
+/// side_safety_dist turn_axis timestamp host logger_timestamp
+LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const LineRef& where) {
+  static const char* kHead[] = {"ROBOTLASER1",        "laser_type",   "start_angle",   "field_of_view",
+                                "angular_resolution", "maximum_range", "accuracy",     "remission_mode",
+                                "num_readings"};
+  static const char* kTail[] = {"laser_pose_x", "laser_pose_y", "laser_pose_theta", "robot_pose_x",
+                                "robot_pose_y", "robot_pose_theta", "laser_tv", "laser_rv",
+                                "forward_safety_dist", "side_safety_dist", "turn_axis", "timestamp",
+                                "host", "logger_timestamp"};
+  if (fields.size() < 9)
+    throw inputError(where.file, where.line, "ROBOTLASER1 line is truncated: it ends before field '" +
+                                                 std::string(kHead[fields.size()]) + "'");
+  const long n = parseCount(fields[8], where, "num_readings", kMaxReadings);
+  if (fields.size() < std::size_t(10 + n))
+    throw inputError(where.file, where.line,
+                     "ROBOTLASER1 line is truncated: it has " + std::to_string(fields.size()) +
+                         " fields and ends before field '" +
+                         (fields.size() < std::size_t(9 + n) ? "range " + std::to_string(fields.size() - 8)
+                                                             : std::string("num_remissions")) +
+                         "' (num_readings = " + std::to_string(n) + ")");
+  const long remissions = parseCount(fields[9 + n], where, "num_remissions", kMaxReadings);
+  const std::size_t tail = 10 + n + remissions;
+  requireFieldCount(fields, tail + 14, where,
+                    "num_readings = " + std::to_string(n) + " and num_remissions = " + std::to_string(remissions),
+                    [&](std::size_t k) {
+                      return k < tail ? "remission " + std::to_string(k - 9 - n) : std::string(kTail[k - tail]);
+                    });
+  LaserScan scan;
+  scan.start_angle = parseFinite(fields[2], where, "start_angle");
+  const double fov = parseFinite(fields[3], where, "field_of_view");
+  scan.angle_step = parseFinite(fields[4], where, "angular_resolution");
+  scan.max_range = parseFinite(fields[5], where, "maximum_range");
+  if (n > 1 && std::abs(scan.angle_step * (n - 1) - fov) > 1e-3 * std::max(1.0, fov))
+    scan.angle_step = fov / (n - 1);  // trust the field of view over a rounded resolution
+  readRanges(fields, 9, n, where, scan);
+  scan.laser_pose = parsePose(fields, tail, where, "laser_pose");
+  return scan;
+}
+
+/// Numeric PARAM values that set the geometry of FLASER/RLASER scans.
+struct LaserParams {
+  std::map<std::string, double> values;
+  std::optional<double> get(const std::string& name) const {
+    const auto it = values.find(name);
+    return it == values.end() ? std::nullopt : std::optional<double>(it->second);
+  }
+};
+
+void readParam(const std::vector<std::string_view>& fields, const LineRef& where, LaserParams& params) {
+  static const char* kKnown[] = {"robot_front_laser_max", "robot_rear_laser_max", "laser_front_laser_resolution",
+                                 "laser_rear_laser_resolution", "laser_front_laser_fov", "laser_rear_laser_fov"};
+  if (fields.size() < 3) return;
+  const std::string name(fields[1]);
+  for (const char* known : kKnown)
+    if (name == known) params.values[name] = parseFinite(fields[2], where, "PARAM " + name);
+}
+
+/// Beam geometry of FLASER/RLASER scans, which the messages do not carry.
+void applyGeometry(LaserScan& scan, LaserSource source, const LaserParams& params, const CarmenOptions& options) {
+  const std::string side = source == LaserSource::Rear ? "rear" : "front";
+  const std::size_t n = scan.ranges.size();
+  double fov_deg = kDefaultFieldOfViewDeg;
+  if (options.field_of_view_deg) fov_deg = *options.field_of_view_deg;
+  else if (auto fov = params.get("laser_" + side + "_laser_fov")) fov_deg = *fov;
+  else if (auto resolution = params.get("laser_" + side + "_laser_resolution"); resolution && n > 1)
+    fov_deg = *resolution * (n - 1);
+  const double fov = fov_deg * kPi / 180.0;
+  scan.start_angle = -fov / 2;  // centred ahead, counter-clockwise (right to left)
+  scan.angle_step = n > 1 ? fov / (n - 1) : 0.0;
+  scan.max_range = params.get("robot_" + side + "_laser_max").value_or(kDefaultMaxRange);
+}
+
+}  // namespace
+
+CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
+  const std::string content = readWholeFile(path);
+  if (content.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path + ": the file is empty");
+
+  // First pass: which laser messages the log holds.
+  std::map<LaserSource, std::size_t> counts;
+  std::vector<std::pair<std::size_t, std::string_view>> lines;  // (line number, text)
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < content.size();) {
+    std::size_t end = content.find('\n', start);
+    if (end == std::string::npos) end = content.size();
+    const std::string_view line(content.data() + start, end - start);
+    lines.emplace_back(++number, line);
+    for (LaserSource s : {LaserSource::Front, LaserSource::Rear, LaserSource::RobotLaser}) {
+      const std::string_view name = messageName(s);
+      if (line.substr(0, name.size()) == name && (line.size() == name.size() || line[name.size()] == ' ' ||
+                                                  line[name.size()] == '\t'))
+        ++counts[s];
+    }
+    start = end + 1;
+  }
+
+  CarmenLog log;
+  log.source = options.laser;
+  if (log.source == LaserSource::Auto) {
+    for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
+      if (counts[s] > 0) {
+        log.source = s;
+        break;
+      }
+    if (log.source == LaserSource::Auto)
+      throw InputError(path + ": no FLASER, RLASER or ROBOTLASER1 message: is this a CARMEN log?");
+  }
+  const std::string chosen = messageName(log.source);
+  if (counts[log.source] == 0)
+    throw InputError(path + ": no " + chosen + " message in this log (--laser " + toString(log.source) + ")");
+  std::string others;
+  for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
+    if (s != log.source && counts[s] > 0)
+      others += (others.empty() ? "" : ", ") + std::to_string(counts[s]) + " " + messageName(s);
+  if (!others.empty())
+    log.warnings.push_back(path + ": using the " + std::to_string(counts[log.source]) + " " + chosen +
+                           " scans; the log also has " + others + " (choose with --laser)");
+
+  // Second pass: parse the chosen messages and the PARAM lines.
+  LaserParams params;
+  for (const auto& [line_number, line] : lines) {
+    const auto fields = splitFields(line);
+    if (fields.empty() || fields[0].front() == '#') continue;
+    const LineRef where{path, line_number};
+    if (fields[0] == "PARAM") {
+      readParam(fields, where, params);
+    } else if (fields[0] == chosen) {
+      LaserScan scan = log.source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
+                                                             : parseFrontOrRearLaser(fields, where);
+      scan.line = line_number;
+      log.scans.push_back(std::move(scan));
+    }
+  }
+  for (LaserScan& scan : log.scans) {
+    if (log.source != LaserSource::RobotLaser) applyGeometry(scan, log.source, params, options);
+    if (options.max_range) scan.max_range = *options.max_range;
+  }
+  return log;
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  cloud->reserve(scan.ranges.size());
+  for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
+    const double r = scan.ranges[k];
+    if (!std::isfinite(r) || r <= 0.0 || r >= scan.max_range) continue;  // no return
+    const double angle = scan.start_angle + k * scan.angle_step;
+    cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
+  }
+  return cloud;
+}
+
+}  // namespace obsgroup::io

@@ -1,0 +1,61 @@
+#pragma once
+// Reader of CARMEN logs (.clf, .log, GMapping's .gfs.log): FLASER, RLASER
+// and ROBOTLASER1 messages.
+
+#include <obsgroup/observation.h>
+
+#include <pcl/point_types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace obsgroup::io {
+
+/// Which laser messages of a log become observations.
+enum class LaserSource {
+  Auto,       ///< ROBOTLASER1 if present, else FLASER, else RLASER.
+  Front,      ///< FLASER
+  Rear,       ///< RLASER
+  RobotLaser  ///< ROBOTLASER1
+};
+
+struct CarmenOptions {
+  LaserSource laser = LaserSource::Auto;
+  /// Field of view of FLASER/RLASER scans in degrees; default: the log's
+  /// PARAM lines, else 180.
+  std::optional<double> field_of_view_deg;
+  /// Readings at or beyond this range are "no return"; default: the
+  /// message's own (ROBOTLASER1), the log's PARAM, else 80 m.
+  std::optional<double> max_range;
+};
+
+/// One scan: ranges and beam geometry in the laser frame (x ahead, y left),
+/// and the laser's pose in the world frame.
+struct LaserScan {
+  std::vector<double> ranges;
+  double start_angle = 0.0;  ///< angle of ranges[0], radians, counter-clockwise
+  double angle_step = 0.0;   ///< angle between consecutive beams
+  double max_range = 0.0;
+  Eigen::Isometry3d laser_pose = Eigen::Isometry3d::Identity();
+  std::size_t line = 0;  ///< line of the log it came from
+};
+
+struct CarmenLog {
+  std::vector<LaserScan> scans;
+  LaserSource source = LaserSource::Auto;  ///< the message kind actually used
+  std::vector<std::string> warnings;       ///< things the user should know
+};
+
+/// Reads a log. Throws InputError naming file, line and field on malformed
+/// input (an empty file, a truncated line, a non-numeric field, a count of
+/// ranges that does not match the line, or no laser message at all).
+CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options = {});
+
+/// The scan's returns as points in the laser frame (z = 0). Non-finite
+/// readings and readings at or beyond max_range give no point.
+pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan);
+
+std::string toString(LaserSource source);
+
+}  // namespace obsgroup::io

@@ -1,0 +1,130 @@
+#include "pcd_sequence.h"
+
+#include "errors.h"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+namespace obsgroup::io {
+
+std::string toString(PointKind kind) {
+  switch (kind) {
+    case PointKind::XYZ: return "PointXYZ";
+    case PointKind::XYZI: return "PointXYZI";
+    case PointKind::XYZRGB: return "PointXYZRGB";
+  }
+  return "?";
+}
+
+namespace {
+
+/// Natural order: runs of digits compare as numbers.
+bool naturalLess(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ei = i, ej = j;
+      while (ei < a.size() && std::isdigit(static_cast<unsigned char>(a[ei]))) ++ei;
+      while (ej < b.size() && std::isdigit(static_cast<unsigned char>(b[ej]))) ++ej;
+      const std::string da = a.substr(i, ei - i), db = b.substr(j, ej - j);
+      const std::string ta = da.substr(std::min(da.find_first_not_of('0'), da.size()));
+      const std::string tb = db.substr(std::min(db.find_first_not_of('0'), db.size()));
+      if (ta.size() != tb.size()) return ta.size() < tb.size();
+      if (ta != tb) return ta < tb;
+      i = ei;
+      j = ej;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j || (a.size() - i == b.size() - j && a < b);
+}
+
+bool isIdentity(const Eigen::Isometry3d& pose) {
+  return (pose.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9;
+}
+
+}  // namespace
+
+std::vector<std::string> listPcdFiles(const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw InputError(folder + ": not a folder");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".pcd" && entry.is_regular_file()) names.push_back(entry.path().filename().string());
+  }
+  if (ec) throw InputError(folder + ": cannot list the folder: " + ec.message());
+  if (names.empty()) throw InputError(folder + ": the folder holds no .pcd file");
+  std::sort(names.begin(), names.end(), naturalLess);
+  std::vector<std::string> files;
+  for (const auto& name : names) files.push_back((fs::path(folder) / name).string());
+  return files;
+}
+
+PointKind detectPointKind(const std::string& file) {
+  pcl::PCDReader reader;
+  pcl::PCLPointCloud2 header;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0, type = 0;
+  unsigned int offset = 0;
+  if (reader.readHeader(file, header, origin, orientation, version, type, offset) < 0)
+    throw InputError(file + ": cannot parse the PCD header");
+  bool has_x = false, has_y = false, has_z = false, intensity = false, rgb = false;
+  for (const auto& field : header.fields) {
+    has_x = has_x || field.name == "x";
+    has_y = has_y || field.name == "y";
+    has_z = has_z || field.name == "z";
+    intensity = intensity || field.name == "intensity";
+    rgb = rgb || field.name == "rgb" || field.name == "rgba";
+  }
+  if (!(has_x && has_y && has_z)) throw InputError(file + ": field 'x', 'y' or 'z' is missing from FIELDS");
+  return rgb ? PointKind::XYZRGB : (intensity ? PointKind::XYZI : PointKind::XYZ);
+}
+
+template <typename PointT>
+PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
+                                    const std::optional<std::vector<Eigen::Isometry3d>>& poses,
+                                    const std::string& poses_file) {
+  if (poses && poses->size() != files.size())
+    throw InputError(poses_file + ": " + std::to_string(poses->size()) + " poses for " +
+                     std::to_string(files.size()) + " PCD files (one pose per file, in name order)");
+  PcdSequence<PointT> out;
+  pcl::PCDReader reader;
+  std::size_t identity_viewpoints = 0;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+    if (reader.read(files[k], *cloud) < 0)
+      throw InputError(files[k] + ": cannot parse this PCD file (malformed header or truncated data)");
+    if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation");
+    const Eigen::Isometry3d viewpoint = poseFromSensorOrigin(*cloud);
+    identity_viewpoints += isIdentity(viewpoint);
+    out.observations.push_back({cloud, poses ? (*poses)[k] : viewpoint});
+  }
+  if (!poses && files.size() > 1 && identity_viewpoints == files.size())
+    out.warnings.push_back("every PCD VIEWPOINT is absent or the identity and no --poses was given: all "
+                           "observations are at the origin, which is almost never what was meant");
+  return out;
+}
+
+template PcdSequence<pcl::PointXYZ> loadPcdSequence(const std::vector<std::string>&,
+                                                    const std::optional<std::vector<Eigen::Isometry3d>>&,
+                                                    const std::string&);
+template PcdSequence<pcl::PointXYZI> loadPcdSequence(const std::vector<std::string>&,
+                                                     const std::optional<std::vector<Eigen::Isometry3d>>&,
+                                                     const std::string&);
+template PcdSequence<pcl::PointXYZRGB> loadPcdSequence(const std::vector<std::string>&,
+                                                       const std::optional<std::vector<Eigen::Isometry3d>>&,
+                                                       const std::string&);
+
+}  // namespace obsgroup::io

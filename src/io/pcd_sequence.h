@@ -1,0 +1,44 @@
+#pragma once
+// A folder of PCD files as a sequence of observations, each posed by its
+// VIEWPOINT or by a trajectory file.
+
+#include "pose_file.h"
+
+#include <obsgroup/observation.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace obsgroup::io {
+
+/// The point type a sequence is read as, chosen from its PCD fields.
+enum class PointKind { XYZ, XYZI, XYZRGB };
+
+std::string toString(PointKind kind);
+
+/// The .pcd files of a folder in natural name order (2.pcd before 10.pcd).
+/// Throws InputError if the folder does not exist or holds no PCD file.
+std::vector<std::string> listPcdFiles(const std::string& folder);
+
+/// XYZRGB when the first file has rgb/rgba, XYZI when it has intensity,
+/// else XYZ. Throws InputError when its header cannot be read.
+PointKind detectPointKind(const std::string& file);
+
+template <typename PointT>
+struct PcdSequence {
+  std::vector<Observation<PointT>> observations;
+  std::vector<std::string> warnings;
+};
+
+/// Loads every file. Poses come from `poses` when given (one per file, in
+/// order), else from each file's VIEWPOINT. Throws InputError naming the PCD
+/// file that cannot be parsed or is truncated, or a poses count that does
+/// not match; warns about empty clouds and about VIEWPOINTs that are all the
+/// identity.
+template <typename PointT>
+PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
+                                    const std::optional<std::vector<Eigen::Isometry3d>>& poses,
+                                    const std::string& poses_file = "");
+
+}  // namespace obsgroup::io

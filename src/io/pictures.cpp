@@ -1,0 +1,300 @@
+#include "pictures.h"
+
+#include <cairo-svg.h>
+#include <cairo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace obsgroup::io {
+
+namespace {
+
+struct Rgb {
+  double r, g, b;
+};
+
+/// Well separated colours for the first groups, then golden-angle hues.
+Rgb groupColour(int group) {
+  static const Rgb kPalette[] = {{0.12, 0.47, 0.71}, {1.00, 0.50, 0.05}, {0.17, 0.63, 0.17}, {0.84, 0.15, 0.16},
+                                 {0.58, 0.40, 0.74}, {0.55, 0.34, 0.29}, {0.89, 0.47, 0.76}, {0.50, 0.50, 0.50},
+                                 {0.74, 0.74, 0.13}, {0.09, 0.75, 0.81}};
+  if (group < 10) return kPalette[group];
+  const double h = std::fmod(group * 0.618033988749895, 1.0) * 6.0;
+  const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
+  const double c = 0.8, m = 0.1;
+  const int sector = static_cast<int>(h);
+  const double rgb[6][3] = {{c, x, 0}, {x, c, 0}, {0, c, x}, {0, x, c}, {x, 0, c}, {c, 0, x}};
+  return {rgb[sector][0] * c + m, rgb[sector][1] * c + m, rgb[sector][2] * c + m};
+}
+
+using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
+using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
+
+Surface imageSurface(int width, int height) {
+  return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
+}
+
+void writePng(const OutputFolder& out, const std::string& name, cairo_surface_t* surface) {
+  out.write(name, [surface](const std::string& temporary) {
+    if (cairo_surface_write_to_png(surface, temporary.c_str()) != CAIRO_STATUS_SUCCESS)
+      throw std::runtime_error(temporary + ": cairo cannot write the PNG");
+  });
+}
+
+void text(cairo_t* cr, double x, double y, const std::string& s, double size = 14) {
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_move_to(cr, x, y);
+  cairo_show_text(cr, s.c_str());
+}
+
+/// World (re-centred) metres to picture pixels, y up.
+struct View {
+  double scale = 1.0, min_x = 0.0, max_y = 0.0, margin = 40.0;
+  int width = 0, height = 0;
+  double px(double x) const { return margin + (x - min_x) * scale; }
+  double py(double y) const { return margin + (max_y - y) * scale; }
+};
+
+View fitView(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions) {
+  Eigen::AlignedBox2d box;
+  for (const auto& p : world.points) box.extend(p.head<2>().cast<double>());
+  for (const auto& p : positions) box.extend(p);
+  if (box.isEmpty()) box.extend(Eigen::Vector2d::Zero());
+  const Eigen::Vector2d size = box.sizes().cwiseMax(1.0);
+  View v;
+  const double longest = 1600.0;
+  v.scale = longest / size.maxCoeff();
+  v.min_x = box.min().x();
+  v.max_y = box.max().y();
+  v.width = static_cast<int>(std::ceil(size.x() * v.scale + 2 * v.margin));
+  v.height = static_cast<int>(std::ceil(size.y() * v.scale + 2 * v.margin + 20));
+  return v;
+}
+
+/// The points, one pixel (or a 2x2 block when they are few) each.
+Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v) {
+  Surface surface = imageSurface(v.width, v.height);
+  cairo_surface_flush(surface.get());
+  unsigned char* data = cairo_image_surface_get_data(surface.get());
+  const int stride = cairo_image_surface_get_stride(surface.get());
+  const int dot = world.points.size() < 300000 ? 2 : 1;
+  for (int i = 0; i < world.size(); ++i) {
+    const Rgb c = groupColour(partition.group_of[i]);
+    const std::uint32_t argb = 0xff000000u | (std::uint32_t(c.r * 255) << 16) | (std::uint32_t(c.g * 255) << 8) |
+                               std::uint32_t(c.b * 255);
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+      const int x = static_cast<int>(v.px(p->x())), y = static_cast<int>(v.py(p->y()));
+      for (int dy = 0; dy < dot; ++dy)
+        for (int dx = 0; dx < dot; ++dx)
+          if (x + dx >= 0 && x + dx < v.width && y + dy >= 0 && y + dy < v.height)
+            reinterpret_cast<std::uint32_t*>(data + (y + dy) * stride)[x + dx] = argb;
+    }
+  }
+  cairo_surface_mark_dirty(surface.get());
+  return surface;
+}
+
+void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vector<Eigen::Vector2d>& positions,
+             const std::vector<double>& headings, const Partition& partition, const TopologicalMap& topology) {
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  cairo_set_source_surface(cr, points, 0, 0);
+  cairo_paint(cr);
+  // Arcs of the topological map between the groups' mean positions.
+  std::vector<Eigen::Vector2d> centre(partition.groups.size(), Eigen::Vector2d::Zero());
+  for (std::size_t g = 0; g < partition.groups.size(); ++g) {
+    for (int i : partition.groups[g]) centre[g] += positions[i];
+    centre[g] /= double(partition.groups[g].size());
+  }
+  cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.6);
+  cairo_set_line_width(cr, 1.5);
+  const double dash[] = {6.0, 4.0};
+  cairo_set_dash(cr, dash, 2, 0);
+  for (const auto& arc : topology.arcs) {
+    cairo_move_to(cr, v.px(centre[arc.from].x()), v.py(centre[arc.from].y()));
+    cairo_line_to(cr, v.px(centre[arc.to].x()), v.py(centre[arc.to].y()));
+    cairo_stroke(cr);
+  }
+  cairo_set_dash(cr, nullptr, 0, 0);
+  // Poses as arrows.
+  const double length = std::max(10.0, 0.5 * v.scale);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Rgb c = groupColour(partition.group_of[i]);
+    const double x = v.px(positions[i].x()), y = v.py(positions[i].y());
+    const double dx = std::cos(headings[i]) * length, dy = -std::sin(headings[i]) * length;
+    cairo_set_source_rgb(cr, c.r * 0.6, c.g * 0.6, c.b * 0.6);
+    cairo_set_line_width(cr, 1.5);
+    cairo_move_to(cr, x, y);
+    cairo_line_to(cr, x + dx, y + dy);
+    cairo_line_to(cr, x + 0.7 * dx - 0.25 * dy, y + 0.7 * dy + 0.25 * dx);
+    cairo_move_to(cr, x + dx, y + dy);
+    cairo_line_to(cr, x + 0.7 * dx + 0.25 * dy, y + 0.7 * dy - 0.25 * dx);
+    cairo_stroke(cr);
+  }
+  // Group labels at their centres.
+  for (std::size_t g = 0; g < centre.size(); ++g) {
+    const double x = v.px(centre[g].x()), y = v.py(centre[g].y());
+    cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
+    cairo_arc(cr, x, y, 11, 0, 2 * M_PI);
+    cairo_fill_preserve(cr);
+    const Rgb c = groupColour(static_cast<int>(g));
+    cairo_set_source_rgb(cr, c.r, c.g, c.b);
+    cairo_set_line_width(cr, 2);
+    cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    text(cr, x - (g < 10 ? 4 : 8), y + 5, std::to_string(g), 13);
+  }
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  char caption[160];
+  std::snprintf(caption, sizeof caption, "%zu observations, %zu groups, %zu arcs; 1 m = %.1f px",
+                positions.size(), partition.groups.size(), topology.arcs.size(), v.scale);
+  text(cr, v.margin, v.height - 12, caption);
+}
+
+}  // namespace
+
+void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
+                      const Partition& partition, const TopologicalMap& topology) {
+  std::vector<Eigen::Vector2d> positions;
+  std::vector<double> headings;
+  for (const auto& pose : poses) {
+    positions.push_back((pose.translation() - world.origin).head<2>());
+    const Eigen::Vector3d ahead = pose.linear().col(0);
+    headings.push_back(std::atan2(ahead.y(), ahead.x()));
+  }
+  const View v = fitView(world, positions);
+  const Surface points = rasterPoints(world, partition, v);
+
+  Surface png = imageSurface(v.width, v.height);
+  {
+    Context cr(cairo_create(png.get()), cairo_destroy);
+    drawMap(cr.get(), points.get(), v, positions, headings, partition, topology);
+  }
+  writePng(out, "map.png", png.get());
+
+  out.write("map.svg", [&](const std::string& temporary) {
+    Surface svg(cairo_svg_surface_create(temporary.c_str(), v.width, v.height), cairo_surface_destroy);
+    {
+      Context cr(cairo_create(svg.get()), cairo_destroy);
+      drawMap(cr.get(), points.get(), v, positions, headings, partition, topology);
+    }
+    cairo_surface_finish(svg.get());
+    if (cairo_surface_status(svg.get()) != CAIRO_STATUS_SUCCESS)
+      throw std::runtime_error(temporary + ": cairo cannot write the SVG");
+  });
+}
+
+void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const Partition& partition) {
+  const int n = static_cast<int>(W.rows());
+  if (n == 0) return;
+  // Position of each observation once ordered by group.
+  std::vector<int> position(n);
+  std::vector<int> group_start;
+  int next = 0;
+  for (const auto& group : partition.groups) {
+    group_start.push_back(next);
+    for (int i : group) position[i] = next++;
+  }
+  group_start.push_back(n);
+  const int side = n <= 800 ? n * std::max(1, 800 / n) : 800;
+  const double cell = double(side) / n;
+  const int margin = 30;
+  std::vector<float> darkness(std::size_t(side) * side, 0.0f);
+  for (int col = 0; col < W.outerSize(); ++col)
+    for (WeightMatrix::InnerIterator it(W, col); it; ++it) {
+      const int x0 = int(position[col] * cell), y0 = int(position[it.row()] * cell);
+      const int x1 = std::max(x0 + 1, int((position[col] + 1) * cell));
+      const int y1 = std::max(y0 + 1, int((position[it.row()] + 1) * cell));
+      for (int y = y0; y < std::min(y1, side); ++y)
+        for (int x = x0; x < std::min(x1, side); ++x) {
+          float& d = darkness[std::size_t(y) * side + x];
+          d = std::max(d, static_cast<float>(std::min(1.0, it.value())));
+        }
+    }
+  Surface surface = imageSurface(side + 2 * margin, side + 2 * margin);
+  Context cr(cairo_create(surface.get()), cairo_destroy);
+  cairo_set_source_rgb(cr.get(), 1, 1, 1);
+  cairo_paint(cr.get());
+  cairo_surface_flush(surface.get());
+  unsigned char* data = cairo_image_surface_get_data(surface.get());
+  const int stride = cairo_image_surface_get_stride(surface.get());
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const auto level = static_cast<std::uint32_t>(255.0f * (1.0f - darkness[std::size_t(y) * side + x]));
+      reinterpret_cast<std::uint32_t*>(data + (y + margin) * stride)[x + margin] =
+          0xff000000u | (level << 16) | (level << 8) | level;
+    }
+  cairo_surface_mark_dirty(surface.get());
+  cairo_set_source_rgb(cr.get(), 0.85, 0.1, 0.1);
+  cairo_set_line_width(cr.get(), 1.5);
+  const double dash[] = {4.0, 3.0};
+  cairo_set_dash(cr.get(), dash, 2, 0);
+  for (std::size_t g = 0; g + 1 < group_start.size(); ++g) {
+    const double a = margin + group_start[g] * cell, b = margin + group_start[g + 1] * cell;
+    cairo_rectangle(cr.get(), a, a, b - a, b - a);
+    cairo_stroke(cr.get());
+  }
+  cairo_set_dash(cr.get(), nullptr, 0, 0);
+  cairo_set_source_rgb(cr.get(), 0, 0, 0);
+  text(cr.get(), margin, 20,
+       "W (" + std::to_string(n) + " x " + std::to_string(n) + "), ordered by group; darker = larger overlap");
+  writePng(out, "weights.png", surface.get());
+}
+
+void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
+  std::vector<const SplitNode*> shown;
+  for (const SplitNode& node : partition.splits)
+    if (node.attempted && node.eigenvector.size() > 0 && shown.size() < 4) shown.push_back(&node);
+  const int plot_w = 640, plot_h = 300, columns = shown.size() > 1 ? 2 : 1;
+  const int rows = std::max<int>(1, (static_cast<int>(shown.size()) + 1) / 2);
+  Surface surface = imageSurface(plot_w * columns, plot_h * rows);
+  Context cr(cairo_create(surface.get()), cairo_destroy);
+  cairo_set_source_rgb(cr.get(), 1, 1, 1);
+  cairo_paint(cr.get());
+  if (shown.empty()) {
+    cairo_set_source_rgb(cr.get(), 0, 0, 0);
+    text(cr.get(), 20, 40, "No spectral bisection was computed (too few or no overlapping observations).");
+  }
+  for (std::size_t k = 0; k < shown.size(); ++k) {
+    const SplitNode& node = *shown[k];
+    const double ox = (k % 2) * plot_w + 50, oy = (k / 2) * plot_h + 40;
+    const double w = plot_w - 80, h = plot_h - 80;
+    const Eigen::VectorXd& y = node.eigenvector;
+    double lo = std::min(y.minCoeff(), node.threshold), hi = std::max(y.maxCoeff(), node.threshold);
+    if (hi - lo < 1e-12) hi = lo + 1.0;
+    const auto sx = [&](double i) { return ox + (y.size() > 1 ? i / (y.size() - 1) : 0.5) * w; };
+    const auto sy = [&](double value) { return oy + h - (value - lo) / (hi - lo) * h; };
+    cairo_set_source_rgb(cr.get(), 0.3, 0.3, 0.3);
+    cairo_set_line_width(cr.get(), 1);
+    cairo_rectangle(cr.get(), ox, oy, w, h);
+    cairo_stroke(cr.get());
+    cairo_set_source_rgb(cr.get(), 0.12, 0.47, 0.71);
+    cairo_set_line_width(cr.get(), 1.2);
+    for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr.get(), sx(i), sy(y[i]));
+    cairo_stroke(cr.get());
+    for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
+      cairo_arc(cr.get(), sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
+      cairo_fill(cr.get());
+    }
+    cairo_set_source_rgb(cr.get(), 0.85, 0.1, 0.1);
+    cairo_move_to(cr.get(), ox, sy(node.threshold));
+    cairo_line_to(cr.get(), ox + w, sy(node.threshold));
+    cairo_stroke(cr.get());
+    cairo_set_source_rgb(cr.get(), 0, 0, 0);
+    char title[200];
+    std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", int(&node - partition.splits.data()),
+                  node.members.size(), node.ncut, node.accepted ? "accepted" : "rejected");
+    text(cr.get(), ox, oy - 12, title);
+    text(cr.get(), ox, oy + h + 20, "observation " + std::to_string(node.members.front()) + " ... " +
+                                        std::to_string(node.members.back()) + " (in order); red: threshold", 12);
+  }
+  writePng(out, "fiedler.png", surface.get());
+}
+
+}  // namespace obsgroup::io

@@ -1,0 +1,77 @@
+#include "pose_file.h"
+
+#include "errors.h"
+#include "text_fields.h"
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+namespace obsgroup::io {
+
+std::string toString(PoseFormat format) { return format == PoseFormat::Tum ? "tum" : "kitti"; }
+
+Eigen::Quaterniond checkedQuaternion(double w, double x, double y, double z) {
+  const Eigen::Quaterniond q(w, x, y, z);
+  const double norm = q.norm();
+  if (!(std::abs(norm - 1.0) <= 0.01))
+    throw std::invalid_argument("the quaternion (qw qx qy qz) = (" + std::to_string(w) + " " + std::to_string(x) +
+                                " " + std::to_string(y) + " " + std::to_string(z) + ") has norm " +
+                                std::to_string(norm) + ", not 1");
+  return q.normalized();
+}
+
+namespace {
+
+Eigen::Isometry3d parseTum(const std::vector<std::string_view>& f, const LineRef& where) {
+  static const char* kNames[] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+  double v[8];
+  for (int k = 0; k < 8; ++k) v[k] = parseFinite(f[k], where, kNames[k]);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << v[1], v[2], v[3];
+  try {
+    pose.linear() = checkedQuaternion(v[7], v[4], v[5], v[6]).toRotationMatrix();
+  } catch (const std::invalid_argument& e) {
+    throw inputError(where.file, where.line, std::string("fields 'qx qy qz qw': ") + e.what());
+  }
+  return pose;
+}
+
+Eigen::Isometry3d parseKitti(const std::vector<std::string_view>& f, const LineRef& where) {
+  Eigen::Matrix<double, 3, 4> m;
+  for (int k = 0; k < 12; ++k)
+    m(k / 4, k % 4) = parseFinite(f[k], where, "r" + std::to_string(k / 4 + 1) + std::to_string(k % 4 + 1));
+  const Eigen::Matrix3d R = m.leftCols<3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-2 || R.determinant() < 0)
+    throw inputError(where.file, where.line, "fields 1-3, 5-7, 9-11: the 3x3 part is not a rotation matrix");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();  // re-orthonormalised
+  pose.translation() = m.col(3);
+  return pose;
+}
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat format) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the poses file");
+  const std::size_t expected = format == PoseFormat::Tum ? 8 : 12;
+  const std::string layout = format == PoseFormat::Tum ? "TUM: timestamp tx ty tz qx qy qz qw"
+                                                       : "KITTI: 12 values of a 3x4 [R|t] matrix";
+  std::vector<Eigen::Isometry3d> poses;
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    const auto fields = splitFields(line);
+    if (fields.empty() || fields[0].front() == '#') continue;
+    const LineRef where{path, number};
+    if (fields.size() != expected)
+      throw inputError(path, number,
+                       "a pose line has " + std::to_string(fields.size()) + " values, expected " +
+                           std::to_string(expected) + " (" + layout + ")");
+    poses.push_back(format == PoseFormat::Tum ? parseTum(fields, where) : parseKitti(fields, where));
+  }
+  if (poses.empty()) throw InputError(path + ": the poses file holds no pose");
+  return poses;
+}
+
+}  // namespace obsgroup::io

@@ -1,0 +1,27 @@
+#pragma once
+// Readers of trajectory files: TUM (timestamp tx ty tz qx qy qz qw) and
+// KITTI (12 numbers per line: a 3x4 row-major [R | t]).
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace obsgroup::io {
+
+enum class PoseFormat { Tum, Kitti };
+
+std::string toString(PoseFormat format);
+
+/// Reads one pose per non-empty, non-comment ('#') line. Throws InputError
+/// naming the file, the line and the field on a wrong number of values, a
+/// non-numeric or non-finite value, a zero or far-from-unit quaternion or a
+/// rotation matrix that is not one. Small deviations (|q| within 1% of 1, a
+/// matrix within 1e-2 of orthonormal) are normalised silently.
+std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat format);
+
+/// The rotation of a quaternion given as (w, x, y, z), normalised; throws
+/// std::invalid_argument when its norm is not within 1% of 1.
+Eigen::Quaterniond checkedQuaternion(double w, double x, double y, double z);
+
+}  // namespace obsgroup::io

@@ -1,0 +1,88 @@
+#include "result_writers.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace obsgroup::io {
+
+namespace {
+
+nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+nlohmann::json splitToJson(const SplitNode& node, std::size_t id) {
+  return {{"id", id},
+          {"parent", node.parent},
+          {"depth", node.depth},
+          {"size", node.members.size()},
+          {"kind", toString(node.kind)},
+          {"outcome", toString(node.outcome)},
+          {"accepted", node.accepted},
+          {"ncut", number(node.ncut)},
+          {"threshold", node.attempted ? number(node.threshold) : nlohmann::json()},
+          {"eigenvalue", number(node.eigenvalue)},
+          {"solver", node.attempted ? (node.sparse_solver ? "sparse" : "dense") : nlohmann::json()},
+          {"children", node.children},
+          {"members", node.members}};
+}
+
+nlohmann::json poseToJson(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"qw", q.w()}, {"qx", q.x()}, {"qy", q.y()}, {"qz", q.z()}};
+}
+
+/// A JSON array with one element per line, indented.
+std::string arrayPerLine(const std::vector<nlohmann::json>& items) {
+  if (items.empty()) return "[]";
+  std::string out = "[\n";
+  for (std::size_t k = 0; k < items.size(); ++k) out += "    " + items[k].dump() + (k + 1 < items.size() ? ",\n" : "\n");
+  return out + "  ]";
+}
+
+}  // namespace
+
+std::string partitionJson(const Partition& partition, const RunRecord& run) {
+  std::vector<nlohmann::json> groups(partition.groups.begin(), partition.groups.end());
+  std::vector<nlohmann::json> splits;
+  for (std::size_t s = 0; s < partition.splits.size(); ++s) splits.push_back(splitToJson(partition.splits[s], s));
+  std::ostringstream out;
+  out << "{\n"
+      << "  \"observations\": " << partition.group_of.size() << ",\n"
+      << "  \"groups\": " << arrayPerLine(groups) << ",\n"
+      << "  \"splits\": " << arrayPerLine(splits) << ",\n"
+      << "  \"parameters\": " << run.parameters.dump() << ",\n"
+      << "  \"statistics\": " << run.statistics.dump() << ",\n"
+      << "  \"input\": " << nlohmann::json(run.input).dump() << ",\n"
+      << "  \"timing_s\": " << run.timing_s.dump() << "\n"
+      << "}\n";
+  return out.str();
+}
+
+std::string topologyJson(const TopologicalMap& map) {
+  std::vector<nlohmann::json> nodes, arcs;
+  for (std::size_t k = 0; k < map.nodes.size(); ++k) {
+    const auto& node = map.nodes[k];
+    nodes.push_back({{"id", k}, {"reference", node.reference}, {"pose", poseToJson(node.pose)},
+                     {"members", node.members}});
+  }
+  for (const auto& arc : map.arcs)
+    arcs.push_back({{"from", arc.from}, {"to", arc.to}, {"weight", arc.weight}, {"pairs", arc.pairs},
+                    {"transform", poseToJson(arc.transform)}});
+  return "{\n  \"nodes\": " + arrayPerLine(nodes) + ",\n  \"arcs\": " + arrayPerLine(arcs) + "\n}\n";
+}
+
+std::string topologyDot(const TopologicalMap& map) {
+  std::ostringstream out;
+  out << "graph topology {\n  node [shape=box];\n";
+  for (std::size_t k = 0; k < map.nodes.size(); ++k)
+    out << "  g" << k << " [label=\"group " << k << "\\n" << map.nodes[k].members.size() << " observations\"];\n";
+  for (const auto& arc : map.arcs) {
+    const Eigen::Vector3d t = arc.transform.translation();
+    out << "  g" << arc.from << " -- g" << arc.to << " [label=\"W " << arc.weight << " (" << arc.pairs
+        << " pairs)\\n" << t.norm() << " m\"];\n";
+  }
+  out << "}\n";
+  return out.str();
+}
+
+}  // namespace obsgroup::io

@@ -1,0 +1,35 @@
+#pragma once
+// partition.json, topology.json and topology.dot: the documented, stable
+// text outputs of `obsgroup partition`.
+
+#include <obsgroup/maps/topological_map.h>
+#include <obsgroup/partition/recursive_partitioner.h>
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace obsgroup::io {
+
+/// What a run was given and did, echoed into partition.json.
+struct RunRecord {
+  std::string input;
+  nlohmann::json parameters;  ///< every parameter actually used
+  nlohmann::json statistics;  ///< points, pairs evaluated, edges of W
+  nlohmann::json timing_s;    ///< seconds per stage (the only part that varies between runs)
+};
+
+/// {"observations": N, "groups": [[...]], "splits": [...], "parameters": {...},
+///  "statistics": {...}, "input": "...", "timing_s": {...}}, keys in this order,
+/// one group and one split per line.
+std::string partitionJson(const Partition& partition, const RunRecord& run);
+
+/// {"nodes": [{"id", "members", "reference", "pose"}], "arcs": [{"from", "to",
+/// "weight", "pairs", "transform"}]}; poses and transforms as x y z qw qx qy qz
+/// at full double precision.
+std::string topologyJson(const TopologicalMap& map);
+
+/// The same graph in GraphViz DOT.
+std::string topologyDot(const TopologicalMap& map);
+
+}  // namespace obsgroup::io

@@ -1,0 +1,65 @@
+#pragma once
+// Splitting a text line into whitespace-separated fields and reading numbers
+// from them, with errors that name the file, the line and the field.
+
+#include "errors.h"
+
+#include <charconv>
+#include <cmath>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace obsgroup::io {
+
+/// The whitespace-separated fields of `line`, as views into it.
+inline std::vector<std::string_view> splitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t k = 0;
+  while (k < line.size()) {
+    while (k < line.size() && (line[k] == ' ' || line[k] == '\t' || line[k] == '\r')) ++k;
+    const std::size_t start = k;
+    while (k < line.size() && line[k] != ' ' && line[k] != '\t' && line[k] != '\r') ++k;
+    if (k > start) fields.push_back(line.substr(start, k - start));
+  }
+  return fields;
+}
+
+/// A line of a text file, for error messages.
+struct LineRef {
+  const std::string& file;
+  std::size_t line;
+};
+
+/// The field as a double ("nan" and "inf" are accepted: the caller decides
+/// whether a non-finite value is allowed).
+inline double parseDouble(std::string_view field, const LineRef& where, const std::string& name) {
+  std::string_view text = field;
+  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size())
+    throw inputError(where.file, where.line, "field '" + name + "': '" + std::string(field) + "' is not a number");
+  return value;
+}
+
+/// The field as a finite double.
+inline double parseFinite(std::string_view field, const LineRef& where, const std::string& name) {
+  const double value = parseDouble(field, where, name);
+  if (!std::isfinite(value))
+    throw inputError(where.file, where.line, "field '" + name + "': '" + std::string(field) + "' is not finite");
+  return value;
+}
+
+/// The field as a non-negative integer no larger than `max`.
+inline long parseCount(std::string_view field, const LineRef& where, const std::string& name, long max) {
+  long value = 0;
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+  if (ec != std::errc() || end != field.data() + field.size() || value < 0 || value > max)
+    throw inputError(where.file, where.line,
+                     "field '" + name + "': '" + std::string(field) + "' is not a count between 0 and " +
+                         std::to_string(max));
+  return value;
+}
+
+}  // namespace obsgroup::io
