@@ -48,30 +48,59 @@ void FloorPlan::addRoom(std::string name, double x0, double y0, double x1, doubl
   room_names_.push_back(std::move(name));
 }
 
+double FloorPlan::castHorizontal(const Eigen::Vector2d& origin, double angle) const {
+  const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
+  double best = std::numeric_limits<double>::infinity();
+  for (const Segment& s : segments_) {
+    // origin + t dir = a + u (b - a), t > 0, u in [0, 1]
+    const Eigen::Vector2d e = s.b - s.a;
+    const double den = dir.x() * (-e.y()) - dir.y() * (-e.x());
+    if (std::abs(den) < 1e-12) continue;
+    const Eigen::Vector2d r = s.a - origin;
+    const double t = (r.x() * (-e.y()) - r.y() * (-e.x())) / den;
+    const double u = (dir.x() * r.y() - dir.y() * r.x()) / den;
+    if (t > 1e-9 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+  }
+  return best;
+}
+
 std::vector<double> FloorPlan::scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed) const {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, laser.range_noise > 0 ? laser.range_noise : 1.0);
   std::vector<double> ranges(laser.beams, laser.max_range);
-  const Eigen::Vector2d origin(pose.x, pose.y);
   const double step = laser.beams > 1 ? laser.field_of_view / (laser.beams - 1) : 0.0;
   for (int k = 0; k < laser.beams; ++k) {
-    const double angle = pose.yaw - laser.field_of_view / 2 + k * step;
-    const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
-    double best = std::numeric_limits<double>::infinity();
-    for (const Segment& s : segments_) {
-      // origin + t dir = a + u (b - a), t > 0, u in [0, 1]
-      const Eigen::Vector2d e = s.b - s.a;
-      const double den = dir.x() * (-e.y()) - dir.y() * (-e.x());
-      if (std::abs(den) < 1e-12) continue;
-      const Eigen::Vector2d r = s.a - origin;
-      const double t = (r.x() * (-e.y()) - r.y() * (-e.x())) / den;
-      const double u = (dir.x() * r.y() - dir.y() * r.x()) / den;
-      if (t > 1e-9 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
-    }
+    const double best = castHorizontal({pose.x, pose.y}, pose.yaw - laser.field_of_view / 2 + k * step);
     const double n = laser.range_noise > 0 ? noise(rng) : 0.0;
     if (best < laser.max_range) ranges[k] = std::min(best + n, laser.max_range);
   }
   return ranges;
+}
+
+std::vector<Eigen::Vector3d> FloorPlan::depthImage(const Pose2D& pose, const DepthCamera& camera,
+                                                   std::uint64_t seed) const {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, camera.range_noise > 0 ? camera.range_noise : 1.0);
+  const double f = (camera.width / 2.0) / std::tan(camera.horizontal_fov / 2);
+  const double cx = (camera.width - 1) / 2.0, cy = (camera.height - 1) / 2.0;
+  const double h = camera.height_above_floor;
+  std::vector<Eigen::Vector3d> points;
+  for (int u = 0; u < camera.width; ++u) {
+    // A pixel column shares one horizontal direction: one 2D cast per column.
+    const double lateral = -(u - cx) / f;
+    const double wall = castHorizontal({pose.x, pose.y}, pose.yaw + std::atan(lateral));
+    for (int v = 0; v < camera.height; ++v) {
+      const Eigen::Vector3d ray = Eigen::Vector3d(1.0, lateral, -(v - cy) / f).normalized();
+      double s = wall / ray.head<2>().norm();  // the ray's length to the wall
+      const double z = h + s * ray.z();
+      if (z < 0.0) s = h / -ray.z();                      // the floor
+      else if (z > ceiling_) s = (ceiling_ - h) / ray.z();  // the ceiling
+      const double n = camera.range_noise > 0 ? noise(rng) : 0.0;
+      if (!(s + n < camera.max_range) || !(s + n > 0)) continue;
+      points.push_back(ray * (s + n));
+    }
+  }
+  return points;
 }
 
 int FloorPlan::roomAt(double x, double y) const {
@@ -94,17 +123,17 @@ std::vector<Eigen::Vector2d> scanToPoints(const std::vector<double>& ranges, con
 
 std::vector<Pose2D> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double spacing) {
   std::vector<Pose2D> poses;
-  double carried = 0.0;  // distance already travelled past the last pose
+  double next = 0.0;  // distance from the start of the current segment to the next pose
   for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) {
     const Eigen::Vector2d d = waypoints[w + 1] - waypoints[w];
     const double length = d.norm();
-    if (length == 0.0) continue;
     const double yaw = std::atan2(d.y(), d.x());
-    for (double s = (poses.empty() ? 0.0 : spacing - carried); s < length; s += spacing) {
+    double s = next;
+    for (; s < length; s += spacing) {
       const Eigen::Vector2d p = waypoints[w] + d * (s / length);
       poses.push_back({p.x(), p.y(), yaw});
-      carried = length - s;
     }
+    next = s - length;  // a segment shorter than the spacing carries it over
   }
   return poses;
 }

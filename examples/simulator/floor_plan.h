@@ -23,6 +23,16 @@ struct LaserModel {
   double range_noise = 0.0;                        ///< Gaussian sigma, metres
 };
 
+/// A depth camera looking along the pose's heading, its optical axis level.
+/// Points come in the sensor frame: x ahead, y left, z up.
+struct DepthCamera {
+  int width = 80, height = 60;
+  double horizontal_fov = 58.0 * 3.14159265358979323846 / 180.0;
+  double height_above_floor = 1.0;  ///< metres
+  double max_range = 6.0;           ///< metres; no point beyond
+  double range_noise = 0.0;         ///< Gaussian sigma along the ray, metres
+};
+
 class FloorPlan {
  public:
   /// A solid axis-aligned box (a wall segment, a pillar, a cupboard).
@@ -40,6 +50,13 @@ class FloorPlan {
   /// yaw - fov/2 + k * fov/(beams-1). Noise comes from `seed`.
   std::vector<double> scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed = 0) const;
 
+  /// Points of one depth image in the sensor frame, the camera standing at
+  /// `camera.height_above_floor` over `pose`. Walls rise from the floor
+  /// (z = 0) to the ceiling; floor and ceiling are seen too.
+  std::vector<Eigen::Vector3d> depthImage(const Pose2D& pose, const DepthCamera& camera,
+                                          std::uint64_t seed = 0) const;
+  void setCeilingHeight(double height) { ceiling_ = height; }
+
   /// Index of the room containing (x, y), or -1.
   int roomAt(double x, double y) const;
   const std::vector<std::string>& roomNames() const { return room_names_; }
@@ -51,7 +68,11 @@ class FloorPlan {
   struct Room {
     double x0, y0, x1, y1;
   };
+  /// Distance along a horizontal ray to the first wall (infinity if none).
+  double castHorizontal(const Eigen::Vector2d& origin, double angle) const;
+
   std::vector<Segment> segments_;
+  double ceiling_ = 2.6;
   std::vector<Room> rooms_;
   std::vector<std::string> room_names_;
 };

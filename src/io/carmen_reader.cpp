@@ -116,7 +116,13 @@ LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const Lin
                          (fields.size() < std::size_t(9 + n) ? "range " + std::to_string(fields.size() - 8)
                                                              : std::string("num_remissions")) +
                          "' (num_readings = " + std::to_string(n) + ")");
-  const long remissions = parseCount(fields[9 + n], where, "num_remissions", kMaxReadings);
+  long remissions = 0;
+  try {
+    remissions = parseCount(fields[9 + n], where, "num_remissions", kMaxReadings);
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) + "; does num_readings = " + std::to_string(n) +
+                     " match the number of ranges?");
+  }
   const std::size_t tail = 10 + n + remissions;
   requireFieldCount(fields, tail + 14, where,
                     "num_readings = " + std::to_string(n) + " and num_remissions = " + std::to_string(remissions),

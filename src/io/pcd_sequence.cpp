@@ -1,6 +1,7 @@
 #include "pcd_sequence.h"
 
 #include "errors.h"
+#include "pcd_header_check.h"
 
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/io/pcd_io.h>
@@ -64,7 +65,11 @@ std::vector<std::string> listPcdFiles(const std::string& folder) {
     if (ext == ".pcd" && entry.is_regular_file()) names.push_back(entry.path().filename().string());
   }
   if (ec) throw InputError(folder + ": cannot list the folder: " + ec.message());
-  if (names.empty()) throw InputError(folder + ": the folder holds no .pcd file");
+  if (names.empty()) {
+    const fs::path inner = fs::path(folder) / "pcd";
+    throw InputError(folder + ": the folder holds no .pcd file" +
+                     (fs::is_directory(inner, ec) ? " (did you mean " + inner.string() + "?)" : std::string()));
+  }
   std::sort(names.begin(), names.end(), naturalLess);
   std::vector<std::string> files;
   for (const auto& name : names) files.push_back((fs::path(folder) / name).string());
@@ -72,6 +77,7 @@ std::vector<std::string> listPcdFiles(const std::string& folder) {
 }
 
 PointKind detectPointKind(const std::string& file) {
+  checkPcdFile(file);
   pcl::PCDReader reader;
   pcl::PCLPointCloud2 header;
   Eigen::Vector4f origin;
@@ -104,6 +110,7 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
   std::size_t identity_viewpoints = 0;
   for (std::size_t k = 0; k < files.size(); ++k) {
     typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+    checkPcdFile(files[k]);
     if (reader.read(files[k], *cloud) < 0)
       throw InputError(files[k] + ": cannot parse this PCD file (malformed header or truncated data)");
     if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation");

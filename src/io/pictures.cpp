@@ -112,11 +112,15 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
     for (int i : partition.groups[g]) centre[g] += positions[i];
     centre[g] /= double(partition.groups[g].size());
   }
-  cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.6);
-  cairo_set_line_width(cr, 1.5);
+  // Stronger arcs (larger cut weight) are drawn thicker and darker.
+  double strongest = 0.0;
+  for (const auto& arc : topology.arcs) strongest = std::max(strongest, arc.weight);
   const double dash[] = {6.0, 4.0};
   cairo_set_dash(cr, dash, 2, 0);
   for (const auto& arc : topology.arcs) {
+    const double strength = arc.weight / strongest;
+    cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.15 + 0.6 * strength);
+    cairo_set_line_width(cr, 0.5 + 2.5 * strength);
     cairo_move_to(cr, v.px(centre[arc.from].x()), v.py(centre[arc.from].y()));
     cairo_line_to(cr, v.px(centre[arc.to].x()), v.py(centre[arc.to].y()));
     cairo_stroke(cr);
@@ -141,6 +145,7 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
   for (std::size_t g = 0; g < centre.size(); ++g) {
     const double x = v.px(centre[g].x()), y = v.py(centre[g].y());
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
+    cairo_new_path(cr);  // the previous label's text leaves a current point
     cairo_arc(cr, x, y, 11, 0, 2 * M_PI);
     cairo_fill_preserve(cr);
     const Rgb c = groupColour(static_cast<int>(g));
@@ -279,6 +284,7 @@ void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
     for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr.get(), sx(i), sy(y[i]));
     cairo_stroke(cr.get());
     for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
+      cairo_new_path(cr.get());
       cairo_arc(cr.get(), sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
       cairo_fill(cr.get());
     }

@@ -1,0 +1,115 @@
+// Generates the simulated inputs shipped in data/ with the scan simulator:
+//   office_2d/office.clf  a CARMEN log (ROBOTLASER1) of a 180-degree laser along
+//                         a corridor and four rooms, 77 scans, with rooms.txt
+//                         giving the room each scan was taken in;
+//   office_3d/            a depth camera (80 x 60) on the same route, 40 clouds:
+//                         pcd/%06d.pcd (pose in VIEWPOINT) and poses.txt (TUM).
+//
+//   make_datasets OUTDIR [--force]
+// The output is deterministic; a test regenerates it and compares with data/.
+
+#include "floor_plan.h"
+
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace obsgroup::sim;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void writeRooms(const FloorPlan& plan, const std::vector<Pose2D>& route, const fs::path& path) {
+  std::ofstream out(path);
+  out << "# index room (ground truth of the simulated office)\n";
+  for (std::size_t i = 0; i < route.size(); ++i) {
+    const int room = plan.roomAt(route[i].x, route[i].y);
+    out << i << ' ' << (room >= 0 ? plan.roomNames()[room] : "outside") << '\n';
+  }
+}
+
+void writeOffice2D(const fs::path& folder) {
+  const FloorPlan plan = office();
+  LaserModel laser;  // 361 beams over 180 degrees, 30 m
+  laser.range_noise = 0.01;
+  const auto route = officeRoute(77);
+  fs::create_directories(folder);
+  std::ofstream out(folder / "office.clf");
+  out << "# CARMEN log written by obsgroup's scan simulator (examples/make_datasets.cpp)\n"
+      << "# a simulated office: a 32 m corridor and four 8 x 6 m rooms; laser at the robot origin\n"
+      << "# message format:\n"
+      << "# ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy "
+         "remission_mode num_readings [range_readings] num_remissions laser_pose_x laser_pose_y "
+         "laser_pose_theta robot_pose_x robot_pose_y robot_pose_theta laser_tv laser_rv "
+         "forward_safety_dist side_safety_dist turn_axis timestamp host logger_timestamp\n";
+  char buffer[160];
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    const Pose2D& p = route[k];
+    const auto ranges = plan.scan(p, laser, k);
+    std::snprintf(buffer, sizeof buffer, "ROBOTLASER1 99 %.9f %.9f %.9f %.6f 0.010000 0 %d", -laser.field_of_view / 2,
+                  laser.field_of_view, laser.field_of_view / (laser.beams - 1), laser.max_range, laser.beams);
+    out << buffer;
+    for (double r : ranges) {
+      std::snprintf(buffer, sizeof buffer, " %.3f", r);
+      out << buffer;
+    }
+    // No remissions; the laser pose, then the robot pose (the laser sits at the robot's origin).
+    std::snprintf(buffer, sizeof buffer, " 0 %.9f %.9f %.9f %.9f %.9f %.9f", p.x, p.y, p.yaw, p.x, p.y, p.yaw);
+    out << buffer;
+    std::snprintf(buffer, sizeof buffer, " 0 0 0 0 0 %.6f obsgroup-sim %.6f\n", 1.0e9 + k * 0.5, k * 0.5);
+    out << buffer;
+  }
+  writeRooms(plan, route, folder / "rooms.txt");
+}
+
+void writeOffice3D(const fs::path& folder) {
+  const FloorPlan plan = office();
+  DepthCamera camera;
+  camera.range_noise = 0.005;
+  const auto route = officeRoute(40);
+  fs::create_directories(folder / "pcd");
+  std::ofstream poses(folder / "poses.txt");
+  poses << "# timestamp tx ty tz qx qy qz qw (camera pose; points: x ahead, y left, z up)\n";
+  char buffer[160];
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    const Pose2D& p = route[k];
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    for (const auto& q : plan.depthImage(p, camera, k)) cloud.push_back(pcl::PointXYZ(float(q.x()), float(q.y()), float(q.z())));
+    cloud.sensor_origin_ << float(p.x), float(p.y), float(camera.height_above_floor), 0.0f;
+    cloud.sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(p.yaw), Eigen::Vector3f::UnitZ()));
+    std::snprintf(buffer, sizeof buffer, "%06zu.pcd", k);
+    pcl::io::savePCDFileBinaryCompressed((folder / "pcd" / buffer).string(), cloud);
+    std::snprintf(buffer, sizeof buffer, "%.1f %.9f %.9f %.9f 0 0 %.12f %.12f\n", k * 0.5, p.x, p.y,
+                  camera.height_above_floor, std::sin(p.yaw / 2), std::cos(p.yaw / 2));
+    poses << buffer;
+  }
+  writeRooms(plan, route, folder / "rooms.txt");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || argc > 3 || (argc == 3 && std::string(argv[2]) != "--force")) {
+    std::cerr << "usage: " << argv[0] << " OUTDIR [--force]\n";
+    return 2;
+  }
+  const fs::path out = argv[1];
+  const bool force = argc == 3;
+  for (const char* name : {"office_2d", "office_3d"}) {
+    if (fs::exists(out / name) && !force) {
+      std::cerr << "error: " << (out / name).string() << " exists; use --force to replace it\n";
+      return 2;
+    }
+  }
+  writeOffice2D(out / "office_2d");
+  writeOffice3D(out / "office_3d");
+  std::cout << "wrote " << (out / "office_2d").string() << " and " << (out / "office_3d").string() << "\n";
+  return 0;
+}

@@ -1,0 +1,127 @@
+#include "pcd_header_check.h"
+
+#include "errors.h"
+#include "text_fields.h"
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <set>
+
+namespace obsgroup::io {
+
+namespace {
+
+struct Header {
+  std::size_t fields = 0;
+  std::size_t point_size = 0;  // bytes per point: sum of SIZE * COUNT
+  long width = -1, height = -1, points = -1;
+  std::string data;
+  std::size_t data_offset = 0;  // bytes before the data
+};
+
+void checkCounts(const std::vector<std::string_view>& f, const Header& h, const LineRef& where) {
+  if (h.fields == 0) throw inputError(where.file, where.line, "field '" + std::string(f[0]) + "' comes before FIELDS");
+  if (f.size() - 1 != h.fields)
+    throw inputError(where.file, where.line,
+                     "field '" + std::string(f[0]) + "' has " + std::to_string(f.size() - 1) + " values for " +
+                         std::to_string(h.fields) + " FIELDS");
+}
+
+Header readHeader(std::ifstream& in, const std::string& path) {
+  Header h;
+  std::vector<long> sizes, counts;
+  std::string line;
+  std::set<std::string> seen;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (number > 64) throw InputError(path + ": no DATA line in the first 64 lines: not a PCD header");
+    const auto f = splitFields(line);
+    if (f.empty() || f[0].front() == '#') continue;
+    const LineRef where{path, number};
+    const std::string key(f[0]);
+    seen.insert(key);
+    if (key == "VERSION") continue;
+    if (key == "FIELDS") {
+      h.fields = f.size() - 1;
+      if (h.fields == 0) throw inputError(path, number, "field 'FIELDS' lists no field");
+    } else if (key == "SIZE") {
+      checkCounts(f, h, where);
+      for (std::size_t k = 1; k < f.size(); ++k) {
+        const long s = parseCount(f[k], where, "SIZE", 8);
+        if (s != 1 && s != 2 && s != 4 && s != 8) throw inputError(path, number, "field 'SIZE': " + std::to_string(s) + " is not 1, 2, 4 or 8");
+        sizes.push_back(s);
+      }
+    } else if (key == "TYPE") {
+      checkCounts(f, h, where);
+      for (std::size_t k = 1; k < f.size(); ++k)
+        if (f[k] != "F" && f[k] != "I" && f[k] != "U")
+          throw inputError(path, number, "field 'TYPE': '" + std::string(f[k]) + "' is not F, I or U");
+    } else if (key == "COUNT") {
+      checkCounts(f, h, where);
+      for (std::size_t k = 1; k < f.size(); ++k) counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
+    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+      if (f.size() != 2) throw inputError(path, number, "field '" + key + "' needs one value");
+      const long v = parseCount(f[1], where, key, 1L << 40);
+      (key == "WIDTH" ? h.width : key == "HEIGHT" ? h.height : h.points) = v;
+    } else if (key == "VIEWPOINT") {
+      if (f.size() != 8) throw inputError(path, number, "field 'VIEWPOINT' needs 7 values (tx ty tz qw qx qy qz)");
+      for (std::size_t k = 1; k < 8; ++k) parseFinite(f[k], where, "VIEWPOINT");
+    } else if (key == "DATA") {
+      if (f.size() != 2 || (f[1] != "ascii" && f[1] != "binary" && f[1] != "binary_compressed"))
+        throw inputError(path, number, "field 'DATA' must be ascii, binary or binary_compressed");
+      h.data = std::string(f[1]);
+      h.data_offset = static_cast<std::size_t>(in.tellg());
+      break;
+    } else {
+      throw inputError(path, number, "unknown header field '" + key + "': not a PCD header");
+    }
+  }
+  if (h.data.empty()) throw InputError(path + ": the PCD header has no DATA line");
+  for (const char* required : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT"})
+    if (!seen.count(required)) throw InputError(path + ": the PCD header has no " + required + " line");
+  if (counts.empty()) counts.assign(h.fields, 1);
+  for (std::size_t k = 0; k < h.fields; ++k) h.point_size += std::size_t(sizes[k] * counts[k]);
+  if (h.points < 0) h.points = h.width * h.height;
+  if (h.points != h.width * h.height)
+    throw InputError(path + ": field 'POINTS' (" + std::to_string(h.points) + ") is not WIDTH * HEIGHT (" +
+                     std::to_string(h.width * h.height) + ")");
+  return h;
+}
+
+}  // namespace
+
+void checkPcdFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the file");
+  const Header h = readHeader(in, path);
+  in.seekg(0, std::ios::end);
+  const std::size_t size = static_cast<std::size_t>(in.tellg());
+  const std::size_t available = size - h.data_offset;
+  const std::size_t expected = std::size_t(h.points) * h.point_size;
+  const std::string truncated = path + ": truncated: the header declares " + std::to_string(h.points) + " points";
+  if (h.data == "binary" && available < expected)
+    throw InputError(truncated + " (" + std::to_string(expected) + " bytes), the file holds " +
+                     std::to_string(available));
+  if (h.data == "binary_compressed" && h.points > 0) {
+    std::uint32_t sizes[2] = {0, 0};  // compressed, uncompressed
+    in.seekg(static_cast<std::streamoff>(h.data_offset));
+    in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
+    if (!in || available < 8 + std::size_t(sizes[0]))
+      throw InputError(truncated + "; its compressed data is cut short");
+    if (sizes[1] != expected)
+      throw InputError(path + ": the compressed data holds " + std::to_string(sizes[1]) + " bytes, the header declares " +
+                       std::to_string(expected));
+  }
+  if (h.data == "ascii") {
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(h.data_offset));
+    std::string line;
+    long lines = 0;
+    while (lines < h.points && std::getline(in, line))
+      if (line.find_first_not_of(" \t\r") != std::string::npos) ++lines;
+    if (lines < h.points)
+      throw InputError(truncated + ", the file holds " + std::to_string(lines) + " data lines");
+  }
+}
+
+}  // namespace obsgroup::io

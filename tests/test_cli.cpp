@@ -1,0 +1,487 @@
+// End-to-end tests of `obsgroup partition` on the shipped data, and its
+// behaviour on bad input: a one-line error naming file, line and field, exit
+// code 2 for usage errors and 3 for input errors.
+#include "floor_plan.h"
+
+#include <cairo.h>
+#include <nlohmann/json.hpp>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kData = OBSGROUP_DATA_DIR;
+
+struct Result {
+  int code = -1;
+  std::string err;
+};
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void writeFile(const fs::path& path, const std::string& content) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << content;
+}
+
+/// A fresh folder per test, removed afterwards.
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "obsgroup_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) const {
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command = std::string(OBSGROUP_EXE) + " " + args + " > /dev/null 2> " + err.string();
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readFile(err)};
+  }
+
+  fs::path dir_;
+};
+
+nlohmann::json readJson(const fs::path& path) { return nlohmann::json::parse(readFile(path)); }
+
+void expectValidPng(const fs::path& path) {
+  const std::string bytes = readFile(path);
+  ASSERT_GT(bytes.size(), 8u) << path;
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << path;
+  cairo_surface_t* s = cairo_image_surface_create_from_png(path.c_str());
+  EXPECT_EQ(cairo_surface_status(s), CAIRO_STATUS_SUCCESS) << path;
+  EXPECT_GT(cairo_image_surface_get_width(s), 100) << path;
+  cairo_surface_destroy(s);
+}
+
+void expectValidSvg(const fs::path& path) {
+  const std::string text = readFile(path);
+  EXPECT_EQ(text.rfind("<?xml", 0), 0u) << path;
+  EXPECT_NE(text.find("<svg"), std::string::npos) << path;
+  EXPECT_NE(text.find("</svg>"), std::string::npos) << path;
+}
+
+/// Checks the documented schema of partition.json and returns it.
+nlohmann::json expectPartitionSchema(const fs::path& out, std::size_t observations) {
+  const nlohmann::json p = readJson(out / "partition.json");
+  EXPECT_EQ(p.at("observations").get<std::size_t>(), observations);
+  std::vector<int> seen(observations, 0);
+  for (const auto& group : p.at("groups")) {
+    EXPECT_FALSE(group.empty());
+    for (int i : group) ++seen.at(i);
+  }
+  for (std::size_t i = 0; i < observations; ++i) EXPECT_EQ(seen[i], 1) << "observation " << i;
+  EXPECT_FALSE(p.at("splits").empty());
+  for (const auto& s : p.at("splits")) {
+    for (const char* key : {"id", "parent", "depth", "kind", "outcome", "accepted", "ncut", "members", "children"})
+      EXPECT_TRUE(s.contains(key)) << key;
+  }
+  for (const char* key : {"delta", "voxel", "ncut_threshold", "split", "min_group_size", "max_depth", "diagonal",
+                          "format", "map_voxel"})
+    EXPECT_TRUE(p.at("parameters").contains(key)) << key;
+  EXPECT_TRUE(p.at("input").is_string());
+  for (const char* key : {"load", "overlap", "graph", "partition", "outputs"})
+    EXPECT_TRUE(p.at("timing_s").at(key).is_number()) << key;
+  return p;
+}
+
+void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
+  const std::size_t groups = partition.at("groups").size();
+  for (std::size_t g = 0; g < groups; ++g) {
+    char name[32];
+    std::snprintf(name, sizeof name, "group_%03zu.pcd", g);
+    pcl::PointCloud<pcl::PointXYZ> map;
+    EXPECT_EQ(pcl::io::loadPCDFile((out / "local_maps" / name).string(), map), 0) << name;
+  }
+  EXPECT_FALSE(fs::exists(out / "local_maps" / ("group_" + std::to_string(1000 + groups) + ".pcd")));
+  const nlohmann::json topology = readJson(out / "topology.json");
+  EXPECT_EQ(topology.at("nodes").size(), groups);
+  for (const auto& arc : topology.at("arcs")) {
+    EXPECT_LT(arc.at("from").get<int>(), arc.at("to").get<int>());
+    EXPECT_GT(arc.at("pairs").get<int>(), 0);
+    for (const char* key : {"x", "y", "z", "qw", "qx", "qy", "qz"}) EXPECT_TRUE(arc.at("transform").contains(key));
+  }
+  EXPECT_EQ(readFile(out / "topology.dot").rfind("graph topology {", 0), 0u);
+  expectValidPng(out / "map.png");
+  expectValidSvg(out / "map.svg");
+  expectValidPng(out / "weights.png");
+  expectValidPng(out / "fiedler.png");
+  for (const auto& entry : fs::recursive_directory_iterator(out))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << "left over: " << entry.path();
+}
+
+/// A CARMEN log line of a simulated scan, in FLASER or ROBOTLASER1 form.
+std::string carmenLine(const std::string& kind, const obsgroup::sim::Pose2D& p, const std::vector<double>& ranges) {
+  std::ostringstream line;
+  line.precision(9);
+  const double fov = 3.14159265358979323846;
+  if (kind == "FLASER") {
+    line << "FLASER " << ranges.size();
+    for (double r : ranges) line << ' ' << r;
+    line << ' ' << p.x << ' ' << p.y << ' ' << p.yaw << ' ' << p.x << ' ' << p.y << ' ' << p.yaw << " 1.0 host 1.0";
+  } else {
+    line << "ROBOTLASER1 0 " << -fov / 2 << ' ' << fov << ' ' << fov / (ranges.size() - 1) << " 30 0.01 0 "
+         << ranges.size();
+    for (double r : ranges) line << ' ' << r;
+    line << " 0 " << p.x << ' ' << p.y << ' ' << p.yaw << ' ' << p.x << ' ' << p.y << ' ' << p.yaw
+         << " 0 0 0 0 0 1.0 host 1.0";
+  }
+  return line.str() + "\n";
+}
+
+/// The same 24 simulated scans of the office as a CARMEN log.
+std::string simulatedLog(const std::string& kind, const std::string& header = "") {
+  const auto plan = obsgroup::sim::office();
+  obsgroup::sim::LaserModel laser;
+  // FLASER carries no maximum range: a PARAM line gives the simulator's 30 m.
+  std::string log = (kind == "FLASER" ? "PARAM robot_front_laser_max 30 0 host 0\n" : "") + header;
+  const auto route = obsgroup::sim::officeRoute(24);
+  for (std::size_t k = 0; k < route.size(); ++k) log += carmenLine(kind, route[k], plan.scan(route[k], laser, k));
+  return log;
+}
+
+/// A small valid CARMEN log whose line `line` (1-based) is replaced.
+std::string logWithLine(int line, const std::string& replacement) {
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string out, text;
+  for (int k = 1; std::getline(in, text); ++k) out += (k == line ? replacement : text) + "\n";
+  return out;
+}
+
+}  // namespace
+
+TEST_F(Cli, OfficeLogEndToEnd) {
+  const Result r = run("partition " + kData + "/office_2d/office.clf -o " + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json p = expectPartitionSchema(dir_ / "out", 77);
+  expectAllOutputs(dir_ / "out", p);
+  EXPECT_EQ(p.at("parameters").at("laser"), "robotlaser");
+  EXPECT_NE(r.err.find("77 observations"), std::string::npos) << r.err;
+
+  // The groups follow the rooms: nearly every scan shares its group's majority room.
+  std::map<int, std::string> room;
+  std::ifstream rooms(kData + "/office_2d/rooms.txt");
+  std::string line;
+  while (std::getline(rooms, line))
+    if (!line.empty() && line[0] != '#') {
+      std::istringstream fields(line);
+      int i;
+      std::string name, rest;
+      fields >> i >> name >> rest;
+      room[i] = name + rest;
+    }
+  ASSERT_EQ(room.size(), 77u);
+  int agreeing = 0;
+  for (const auto& group : p.at("groups")) {
+    std::map<std::string, int> votes;
+    for (int i : group) ++votes[room[i]];
+    int best = 0;
+    for (const auto& [name, count] : votes) best = std::max(best, count);
+    agreeing += best;
+  }
+  EXPECT_GE(agreeing, 70) << agreeing << " of 77 scans share their group's room";
+}
+
+TEST_F(Cli, DepthCameraSequenceWithViewpointsOrPoses) {
+  const Result a = run("partition " + kData + "/office_3d/pcd -q -o " + (dir_ / "a").string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  const nlohmann::json p = expectPartitionSchema(dir_ / "a", 40);
+  expectAllOutputs(dir_ / "a", p);
+  EXPECT_EQ(p.at("parameters").at("format"), "pcd");
+  const Result b = run("partition " + kData + "/office_3d/pcd -q --poses " + kData + "/office_3d/poses.txt -o " +
+                       (dir_ / "b").string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(readJson(dir_ / "b" / "partition.json").at("groups"), p.at("groups"));
+}
+
+TEST_F(Cli, RealLogsFromMrptDatasets) {
+  const Result r = run("partition " + kData + "/real/localization_demo/localization_demo.clf --no-pictures -o " +
+                       (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  expectPartitionSchema(dir_ / "out", 72);
+  const Result pcd = run("partition " + kData + "/real/sena_odometry/pcd --no-pictures -q -o " +
+                         (dir_ / "pcd").string());
+  ASSERT_EQ(pcd.code, 0) << pcd.err;
+  expectPartitionSchema(dir_ / "pcd", 224);
+}
+
+TEST_F(Cli, FlaserAndRobotlaserOfTheSameScansAgree) {
+  writeFile(dir_ / "flaser.log", simulatedLog("FLASER"));
+  writeFile(dir_ / "robot.clf", simulatedLog("ROBOTLASER1"));
+  ASSERT_EQ(run("partition " + (dir_ / "flaser.log").string() + " -q --no-pictures -o " + (dir_ / "f").string()).code, 0);
+  ASSERT_EQ(run("partition " + (dir_ / "robot.clf").string() + " -q --no-pictures -o " + (dir_ / "r").string()).code, 0);
+  const auto f = readJson(dir_ / "f" / "partition.json"), r = readJson(dir_ / "r" / "partition.json");
+  EXPECT_EQ(f.at("groups"), r.at("groups"));
+  EXPECT_EQ(f.at("statistics").at("points"), r.at("statistics").at("points"));
+  EXPECT_EQ(f.at("parameters").at("laser"), "front");
+
+  // A PARAM line saying the scans cover 90 degrees changes their geometry...
+  writeFile(dir_ / "narrow.log", simulatedLog("FLASER", "PARAM laser_front_laser_fov 90 0 host 0\n"));
+  ASSERT_EQ(run("partition " + (dir_ / "narrow.log").string() + " -q --no-pictures -o " + (dir_ / "n").string()).code, 0);
+  EXPECT_NE(readJson(dir_ / "n" / "partition.json").at("statistics").at("point_tests"),
+            f.at("statistics").at("point_tests"));
+  // ...and --fov 180 overrides it back.
+  ASSERT_EQ(run("partition " + (dir_ / "narrow.log").string() + " --fov 180 -q --no-pictures -o " +
+                (dir_ / "o").string()).code, 0);
+  EXPECT_EQ(readJson(dir_ / "o" / "partition.json").at("groups"), f.at("groups"));
+}
+
+TEST_F(Cli, LogWithSeveralLasersWarnsAndObeysLaserOption) {
+  writeFile(dir_ / "both.log", simulatedLog("FLASER") + simulatedLog("ROBOTLASER1"));
+  const Result r = run("partition " + (dir_ / "both.log").string() + " --no-pictures -o " + (dir_ / "a").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("--laser"), std::string::npos) << r.err;
+  EXPECT_EQ(readJson(dir_ / "a" / "partition.json").at("observations"), 24);
+  const Result rear = run("partition " + (dir_ / "both.log").string() + " --laser rear -o " + (dir_ / "b").string());
+  EXPECT_EQ(rear.code, 3);
+  EXPECT_NE(rear.err.find("no RLASER"), std::string::npos) << rear.err;
+}
+
+TEST_F(Cli, NanAndInfReadingsAreNoReturn) {
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string line, log;
+  std::getline(in, line);
+  std::vector<std::string> fields;
+  std::istringstream split(line);
+  for (std::string f; split >> f;) fields.push_back(f);
+  fields[9] = "nan";  // the first three ranges
+  fields[10] = "inf";
+  fields[11] = "-nan";
+  for (const auto& f : fields) log += f + " ";
+  log += "\n";
+  while (std::getline(in, line)) log += line + "\n";
+  writeFile(dir_ / "nan.clf", log);
+  writeFile(dir_ / "clean.clf", simulatedLog("ROBOTLASER1"));
+  Result r = run("partition " + (dir_ / "nan.clf").string() + " -q --no-pictures -o " + (dir_ / "n").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("partition " + (dir_ / "clean.clf").string() + " -q --no-pictures -o " + (dir_ / "c").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Three readings fewer: they gave no point.
+  EXPECT_EQ(readJson(dir_ / "n" / "partition.json").at("statistics").at("points").get<int>() + 3,
+            readJson(dir_ / "c" / "partition.json").at("statistics").at("points").get<int>());
+}
+
+TEST_F(Cli, BadCarmenLogs) {
+  struct Case {
+    std::string name, content, expected;
+  };
+  const std::string line2 = simulatedLog("ROBOTLASER1").substr(0, simulatedLog("ROBOTLASER1").find('\n'));
+  std::vector<Case> cases{
+      {"empty", "", "the file is empty"},
+      {"blank", "\n  \n", "the file is empty"},
+      {"no_laser", "# a comment\nODOM 1 2 3 0 0 0 1 host 1\n", "no FLASER, RLASER or ROBOTLASER1"},
+      {"truncated", logWithLine(3, line2.substr(0, line2.size() / 2)), ":3: ROBOTLASER1 line is truncated"},
+      {"truncated_tail", logWithLine(2, line2.substr(0, line2.rfind(" 0 0 0 0 0"))), ":2: ROBOTLASER1 line is truncated"},
+      {"non_numeric", logWithLine(4, std::string(line2).replace(line2.find(" 361 ") + 5, 0, "abc ")), ":4: "},
+      {"n_mismatch", logWithLine(5, std::string(line2).replace(line2.find(" 361 "), 5, " 360 ")), ":5: "},
+      {"bad_pose",
+       logWithLine(2, carmenLine("ROBOTLASER1", {std::nan(""), 1.0, 0.0}, std::vector<double>(361, 5.0))),
+       ":2: field 'laser_pose_x': 'nan' is not finite"},
+      {"flaser_short", "FLASER 3 1.0 2.0\n", ":1: FLASER line is truncated"},
+      {"flaser_bad_count", "FLASER x 1.0\n", ":1: field 'num_readings'"},
+  };
+  for (const auto& c : cases) {
+    const fs::path log = dir_ / (c.name + ".clf");
+    writeFile(log, c.content);
+    const Result r = run("partition " + log.string() + " -o " + (dir_ / ("out_" + c.name)).string());
+    EXPECT_EQ(r.code, 3) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(log.string()), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": one line expected: " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / ("out_" + c.name) / "partition.json")) << c.name;
+  }
+  // A non-numeric range names its field; n not matching the ranges says so.
+  writeFile(dir_ / "word.clf", logWithLine(2, std::string(line2).replace(line2.find(" 361 ") + 5, 5, "abc ")));
+  Result r = run("partition " + (dir_ / "word.clf").string() + " -o " + (dir_ / "w").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find(":2: field 'range 1': 'abc' is not a number"), std::string::npos) << r.err;
+  writeFile(dir_ / "count.clf", logWithLine(2, std::string(line2).replace(line2.find(" 361 "), 5, " 360 ")));
+  r = run("partition " + (dir_ / "count.clf").string() + " -o " + (dir_ / "c").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("match the number of ranges"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, BadPcdSequences) {
+  fs::create_directories(dir_ / "none");
+  writeFile(dir_ / "none" / "readme.txt", "no clouds here");
+  Result r = run("partition " + (dir_ / "none").string() + " -o " + (dir_ / "o1").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("no .pcd file"), std::string::npos) << r.err;
+
+  // Garbage, and a binary PCD cut in the middle of its data.
+  const fs::path seq = dir_ / "seq";
+  fs::create_directories(seq);
+  fs::copy_file(kData + "/office_3d/pcd/000000.pcd", seq / "000000.pcd");
+  fs::copy_file(kData + "/office_3d/pcd/000001.pcd", seq / "000001.pcd");
+  writeFile(seq / "000002.pcd", "this is not a point cloud\n");
+  r = run("partition " + seq.string() + " -o " + (dir_ / "o2").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("000002.pcd:1: unknown header field 'this'"), std::string::npos) << r.err;
+  const std::string whole = readFile(kData + "/office_3d/pcd/000002.pcd");
+  writeFile(seq / "000002.pcd", whole.substr(0, whole.size() * 2 / 3));
+  r = run("partition " + seq.string() + " -o " + (dir_ / "o3").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("000002.pcd: truncated"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o3" / "partition.json"));
+  // Headers that are inconsistent or cut short.
+  const std::string head = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  const std::vector<std::pair<std::string, std::string>> headers{
+      {head + "WIDTH 2\nHEIGHT 1\nPOINTS 3\nDATA ascii\n1 2 3\n4 5 6\n", "'POINTS' (3) is not WIDTH * HEIGHT"},
+      {head + "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3\n", "truncated"},
+      {head + "WIDTH 2\nHEIGHT 1\nPOINTS 2\n", "no DATA line"},
+      {"VERSION .7\nFIELDS x y z\nSIZE 4 4\n", ":3: field 'SIZE' has 2 values for 3 FIELDS"},
+      {head + "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n", ":8: field 'VIEWPOINT'"},
+  };
+  for (const auto& [text, expected] : headers) {
+    writeFile(seq / "000002.pcd", text);
+    r = run("partition " + seq.string() + " -o " + (dir_ / "o5").string());
+    EXPECT_EQ(r.code, 3) << expected;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+  }
+
+  // An empty but valid PCD is an observation with no points: kept, with a warning.
+  pcl::PointCloud<pcl::PointXYZ> empty;
+  empty.sensor_origin_ << 1.0f, 2.0f, 0.0f, 0.0f;
+  pcl::io::savePCDFileASCII((seq / "000002.pcd").string(), empty);
+  r = run("partition " + seq.string() + " --no-pictures -o " + (dir_ / "o4").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("000002.pcd: no point"), std::string::npos) << r.err;
+  EXPECT_EQ(readJson(dir_ / "o4" / "partition.json").at("observations"), 3);
+}
+
+TEST_F(Cli, BadPoseFiles) {
+  const std::string seq = kData + "/office_3d/pcd";
+  const std::string poses = readFile(kData + "/office_3d/poses.txt");
+  const auto runWith = [&](const std::string& name, const std::string& content, const std::string& format = "tum") {
+    writeFile(dir_ / name, content);
+    return run("partition " + seq + " --no-pictures -q --poses " + (dir_ / name).string() + " --pose-format " +
+               format + " -o " + (dir_ / ("out_" + name)).string());
+  };
+  const std::string last_removed = poses.substr(0, poses.rfind('\n', poses.size() - 2) + 1);
+  Result r = runWith("fewer.txt", last_removed);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("39 poses for 40 PCD files"), std::string::npos) << r.err;
+  r = runWith("more.txt", poses + "99 0 0 0 0 0 0 1\n");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("41 poses for 40 PCD files"), std::string::npos) << r.err;
+  r = runWith("short.txt", "# header\n0 1 2 3 0 0 0\n");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("short.txt:2: a pose line has 7 values, expected 8"), std::string::npos) << r.err;
+  r = runWith("zero.txt", "0 1 2 3 0 0 0 0\n");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("zero.txt:1: fields 'qx qy qz qw'"), std::string::npos) << r.err;
+  r = runWith("far.txt", "0 1 2 3 0 0 0 1.5\n");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("norm 1.5"), std::string::npos) << r.err;
+  r = runWith("word.txt", "0 1 two 3 0 0 0 1\n");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("word.txt:1: field 'ty': 'two' is not a number"), std::string::npos) << r.err;
+  r = runWith("kitti.txt", "1 0 0 0 0 1 0 0 0 0 1\n", "kitti");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("kitti.txt:1: a pose line has 11 values, expected 12"), std::string::npos) << r.err;
+  r = runWith("shear.txt", "1 0.5 0 0 0 1 0 0 0 0 1 0\n", "kitti");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("not a rotation matrix"), std::string::npos) << r.err;
+
+  // A quaternion a little off unit length is normalised silently.
+  std::string nearly;
+  std::istringstream in(poses);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream f(line);
+    double v[8];
+    for (double& x : v) f >> x;
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer, "%g %.9f %.9f %.9f 0 0 %.12f %.12f\n", v[0], v[1], v[2], v[3], v[6] * 1.002,
+                  v[7] * 1.002);
+    nearly += buffer;
+  }
+  r = runWith("nearly.txt", nearly);
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
+TEST_F(Cli, IdentityViewpointsWarn) {
+  const fs::path seq = dir_ / "seq";
+  fs::create_directories(seq);
+  for (int k = 0; k < 3; ++k) {
+    pcl::PointCloud<pcl::PointXYZ> cloud;
+    pcl::io::loadPCDFile(kData + "/office_3d/pcd/00000" + std::to_string(k) + ".pcd", cloud);
+    cloud.sensor_origin_.setZero();
+    cloud.sensor_orientation_.setIdentity();
+    pcl::io::savePCDFileBinary((seq / ("c" + std::to_string(k) + ".pcd")).string(), cloud);
+  }
+  const Result r = run("partition " + seq.string() + " --no-pictures -o " + (dir_ / "o").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("all observations are at the origin"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, ExistingResultsAreNotOverwrittenWithoutForce) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const std::string out = (dir_ / "out").string();
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + out).code, 0);
+  const std::string before = readFile(dir_ / "out" / "partition.json");
+  writeFile(dir_ / "out" / "local_maps" / "group_999.pcd", "stale");
+  const Result refused = run("partition " + input + " --delta 0.2 -q -o " + out);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("already holds results"), std::string::npos) << refused.err;
+  EXPECT_EQ(readFile(dir_ / "out" / "partition.json"), before);
+  ASSERT_EQ(run("partition " + input + " --delta 0.2 -q --no-pictures --force -o " + out).code, 0);
+  EXPECT_EQ(readJson(dir_ / "out" / "partition.json").at("parameters").at("delta"), 0.2);
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "local_maps" / "group_999.pcd"));
+}
+
+TEST_F(Cli, UsageErrors) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const std::string out = " -o " + (dir_ / "out").string();
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("partition " + input).code, 2);                           // no -o
+  EXPECT_EQ(run("partition " + input + out + " --delta -1").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --delta abc").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --split median").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --no-such-option").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --poses x.txt").code, 2);  // poses for a log
+  EXPECT_EQ(run("partition " + kData + "/office_3d/pcd" + out + " --laser front").code, 2);
+  const Result missing = run("partition " + (dir_ / "nothing.clf").string() + out);
+  EXPECT_EQ(missing.code, 3);
+  EXPECT_NE(missing.err.find("no such file or folder"), std::string::npos) << missing.err;
+  EXPECT_EQ(run("--help").code, 0);
+  EXPECT_EQ(run("partition --help").code, 0);
+}
+
+TEST_F(Cli, SameResultsForOneAndTwoThreads) {
+  const std::string input = kData + "/real/localization_demo/localization_demo.clf";
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures --threads 1 -o " + (dir_ / "one").string()).code, 0);
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures --threads 2 -o " + (dir_ / "two").string()).code, 0);
+  const auto strip = [](std::string text) { return text.substr(0, text.find("\"timing_s\"")); };
+  EXPECT_EQ(strip(readFile(dir_ / "one" / "partition.json")), strip(readFile(dir_ / "two" / "partition.json")));
+  EXPECT_EQ(readFile(dir_ / "one" / "topology.json"), readFile(dir_ / "two" / "topology.json"));
+}
+
+TEST_F(Cli, ShippedDatasetsAreWhatTheSimulatorWrites) {
+  const std::string command = std::string(MAKE_DATASETS_EXE) + " " + dir_.string() + " > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  EXPECT_EQ(readFile(dir_ / "office_2d" / "office.clf"), readFile(kData + "/office_2d/office.clf"));
+  EXPECT_EQ(readFile(dir_ / "office_3d" / "poses.txt"), readFile(kData + "/office_3d/poses.txt"));
+  EXPECT_EQ(readFile(dir_ / "office_3d" / "pcd" / "000017.pcd"), readFile(kData + "/office_3d/pcd/000017.pcd"));
+}
