@@ -12,6 +12,7 @@
 #include <obsgroup/observation_grouping.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -51,10 +52,6 @@ void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences only");
   if (format == "pcd" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
-}
-
-nlohmann::json optional(const std::optional<double>& value) {
-  return value ? nlohmann::json(*value) : nlohmann::json();
 }
 
 void warn(const PartitionArgs& args, const std::string& message) {
@@ -162,9 +159,12 @@ int runCarmen(const PartitionArgs& args) {
     observations.push_back({io::scanToCloud(scan), scan.laser_pose});
     input.labels.push_back(args.input + ":" + std::to_string(scan.line));
   }
+  // The beam geometry actually used (from the messages, PARAM lines or options), as read off the first scan.
+  const io::LaserScan& first = log.scans.front();
+  const double fov_deg = first.angle_step * (first.ranges.size() > 1 ? first.ranges.size() - 1 : 0) * 180.0 / M_PI;
   input.parameters = {{"laser", io::toString(log.source)},
-                      {"fov_deg", optional(args.field_of_view_deg)},
-                      {"max_range", optional(args.max_range)},
+                      {"fov_deg", fov_deg},
+                      {"max_range", first.max_range},
                       {"point_type", io::toString(io::PointKind::XYZ)}};
   input.warnings = std::move(log.warnings);
   input.load_s = secondsSince(start);

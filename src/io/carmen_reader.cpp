@@ -132,10 +132,10 @@ LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const Lin
   LaserScan scan;
   scan.start_angle = parseFinite(fields[2], where, "start_angle");
   const double fov = parseFinite(fields[3], where, "field_of_view");
-  scan.angle_step = parseFinite(fields[4], where, "angular_resolution");
+  const double resolution = parseFinite(fields[4], where, "angular_resolution");
   scan.max_range = parseFinite(fields[5], where, "maximum_range");
-  if (n > 1 && std::abs(scan.angle_step * (n - 1) - fov) > 1e-3 * std::max(1.0, fov))
-    scan.angle_step = fov / (n - 1);  // trust the field of view over a rounded resolution
+  // Loggers round the resolution; the field of view spans the beams exactly.
+  scan.angle_step = n > 1 ? fov / (n - 1) : resolution;
   readRanges(fields, 9, n, where, scan);
   scan.laser_pose = parsePose(fields, tail, where, "laser_pose");
   return scan;
