@@ -16,8 +16,8 @@ set(CMAKE_DISABLE_FIND_PACKAGE_RSSDK TRUE)
 set(CMAKE_DISABLE_FIND_PACKAGE_RSSDK2 TRUE)
 
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
-find_package(PCL 1.10 REQUIRED COMPONENTS common kdtree search filters)
+find_package(PCL 1.10 REQUIRED COMPONENTS common kdtree search filters registration)
 find_package(OpenMP REQUIRED)
 find_package(Spectra 1.0 REQUIRED CONFIG)
 
-set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters)
+set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters pcl_registration)

@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// The metric-topological map of paper sec. IV-A, step 4: one node per group
-/// (local map), arcs between groups whose observations overlap, each holding
-/// the relative transform between the two local maps' reference frames.
+/// The metric-topological map of paper sec. IV-A, step 4: one node per local
+/// map, arcs between local maps whose observations overlap or follow each
+/// other, each holding the relative transform between their reference frames.
 
 #include "obsgroup/graph/observation_graph.h"
 #include "obsgroup/partition/recursive_partitioner.h"
@@ -13,31 +13,62 @@
 
 namespace obsgroup {
 
-struct TopologicalNode {
-  std::vector<int> members;  ///< Observation indices of the group, ascending.
-  int reference = -1;        ///< Observation whose frame is the local map's frame.
+/// The frame of one local map: its observations expressed relative to a
+/// reference observation (paper sec. IV-A, step 3).
+struct LocalMapFrame {
+  std::vector<int> members;  ///< Observation indices, ascending.
+  int reference = -1;        ///< The member whose frame is the local map's frame.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< Reference pose in the global frame.
+  /// Pose of each member (in `members` order) in the reference frame; the
+  /// reference's own is the identity. Refinement changes these.
+  std::vector<Eigen::Isometry3d> member_poses;
+
+  /// Pose of observation `i` (a member) in the reference frame.
+  const Eigen::Isometry3d& memberPose(int i) const;
 };
 
+/// The member with the largest sum of W to the other members (the most
+/// strongly connected); ties go to the smaller index.
+int strongestMember(const std::vector<int>& group, const WeightMatrix& W);
+
+/// A group's frame from the input poses: reference = strongestMember, member
+/// poses = pose_ref^-1 * pose_i.
+LocalMapFrame initialFrame(const std::vector<int>& group, const WeightMatrix& W,
+                           const std::vector<Eigen::Isometry3d>& poses);
+
 struct TopologicalArc {
-  int from = 0, to = 0;        ///< Node indices, from < to.
-  double weight = 0.0;         ///< Sum of W over the cross pairs: cut(from, to) of eq. (2).
-  int pairs = 0;               ///< Overlapping cross pairs (a in from, b in to, W_ab > 0).
-  /// Pose of `to`'s reference frame in `from`'s: pose_from^-1 * pose_to.
+  int from = 0, to = 0;           ///< Node indices, from < to.
+  /// Pose of `to`'s reference frame in `from`'s, averaged over the supporting pairs.
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  double translation_spread = 0.0;  ///< Spread of the pair estimates: the arc's uncertainty, metres.
+  double rotation_spread = 0.0;     ///< Same for rotation, radians.
+  double weight = 0.0;              ///< Sum of W over the cross pairs: cut(from, to) of eq. (2).
+  int overlapping_pairs = 0;        ///< Cross pairs (a, b) with W_ab > 0.
+  int sequence_pairs = 0;           ///< Cross pairs (i, i+1) of consecutive observations.
+  int pairs = 0;                    ///< Distinct pairs that support the arc.
 };
 
 struct TopologicalMap {
-  std::vector<TopologicalNode> nodes;
+  std::vector<LocalMapFrame> nodes;
   std::vector<TopologicalArc> arcs;  ///< Ordered by (from, to).
 };
 
-/// Builds the topological map of a partition: each group's reference is its
-/// first observation, and an arc joins two groups when W is non-zero across
-/// them. With the observations' poses in one global frame, every cross pair
-/// (a, b) gives the same estimate pose_from^-1 pose_a (pose_a^-1 pose_b)
-/// pose_b^-1 pose_to of the arc's transform, which is therefore exact.
-TopologicalMap buildTopologicalMap(const Partition& partition, const WeightMatrix& W,
+/// Weight given to a pair of consecutive observations that do not overlap
+/// (W = 0): it joins two local maps the robot drove between, but says little
+/// about their relative pose next to pairs that overlap.
+inline constexpr double kSequencePairWeight = 1e-3;
+
+/// Builds the arcs between local maps. Each supporting cross pair (a in A, b
+/// in B) gives the estimate M_a (pose_a^-1 pose_b) M_b^-1 of the transform
+/// from A's reference frame to B's, where M are the members' (possibly
+/// refined) poses in their local maps; the arc holds the W-weighted mean
+/// (averagePoses) and its spread. With unrefined local maps all estimates
+/// coincide and the spread is 0.
+TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
                                    const std::vector<Eigen::Isometry3d>& poses);
+
+/// The frames of all groups of a partition from the input poses.
+std::vector<LocalMapFrame> initialFrames(const Partition& partition, const WeightMatrix& W,
+                                         const std::vector<Eigen::Isometry3d>& poses);
 
 }  // namespace obsgroup
