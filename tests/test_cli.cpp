@@ -120,7 +120,20 @@ void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
   for (const auto& arc : topology.at("arcs")) {
     EXPECT_LT(arc.at("from").get<int>(), arc.at("to").get<int>());
     EXPECT_GT(arc.at("pairs").get<int>(), 0);
+    EXPECT_GE(arc.at("spread").at("translation_m").get<double>(), 0.0);
     for (const char* key : {"x", "y", "z", "qw", "qx", "qy", "qz"}) EXPECT_TRUE(arc.at("transform").contains(key));
+  }
+  // Each local map is written in its reference's frame, with the reference's pose as VIEWPOINT.
+  for (std::size_t g = 0; g < groups; ++g) {
+    const auto& node = topology.at("nodes").at(g);
+    EXPECT_EQ(node.at("members"), partition.at("groups").at(g));
+    EXPECT_EQ(node.at("member_poses").size(), node.at("members").size());
+    char name[32];
+    std::snprintf(name, sizeof name, "group_%03zu.pcd", g);
+    pcl::PointCloud<pcl::PointXYZ> map;
+    pcl::io::loadPCDFile((out / "local_maps" / name).string(), map);
+    EXPECT_NEAR(map.sensor_origin_.x(), node.at("pose").at("x").get<double>(), 1e-3);
+    EXPECT_NEAR(map.sensor_origin_.y(), node.at("pose").at("y").get<double>(), 1e-3);
   }
   EXPECT_EQ(readFile(out / "topology.dot").rfind("graph topology {", 0), 0u);
   expectValidPng(out / "map.png");
@@ -213,6 +226,23 @@ TEST_F(Cli, DepthCameraSequenceWithViewpointsOrPoses) {
                        (dir_ / "b").string());
   ASSERT_EQ(b.code, 0) << b.err;
   EXPECT_EQ(readJson(dir_ / "b" / "partition.json").at("groups"), p.at("groups"));
+}
+
+TEST_F(Cli, RefinedLocalMaps) {
+  for (const std::string refine : {"icp", "lum"}) {
+    const fs::path out = dir_ / refine;
+    const Result r = run("partition " + kData + "/office_2d/office.clf -q --refine " + refine + " -o " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json p = expectPartitionSchema(out, 77);
+    expectAllOutputs(out, p);
+    EXPECT_EQ(p.at("parameters").at("refine"), refine);
+  }
+  // Refinement moves member poses, so the arcs' estimates now spread.
+  const auto icp = readJson(dir_ / "icp" / "topology.json");
+  double spread = 0.0;
+  for (const auto& arc : icp.at("arcs")) spread = std::max(spread, arc.at("spread").at("translation_m").get<double>());
+  EXPECT_GT(spread, 0.0);
+  EXPECT_EQ(run("partition " + kData + "/office_2d/office.clf --refine slam -o " + (dir_ / "x").string()).code, 2);
 }
 
 TEST_F(Cli, RealLogsFromMrptDatasets) {

@@ -70,6 +70,12 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
   command.add_option("--threads", args.threads, "threads (0 = all cores); results do not depend on it")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  const std::map<std::string, obsgroup::Refinement> refinements{{"none", obsgroup::Refinement::None},
+                                                                {"icp", obsgroup::Refinement::Icp},
+                                                                {"lum", obsgroup::Refinement::Lum}};
+  command.add_option("--refine", args.refine,
+                     "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios)")
+      ->transform(CLI::CheckedTransformer(refinements));
   command.add_option("--map-voxel", map_voxel, "voxel leaf of the local maps written, metres (default: delta/2)")
       ->check(CLI::NonNegativeNumber);
   command.add_flag("--force", args.force, "replace the results already in the output folder");

@@ -5,6 +5,7 @@
 #include "carmen_reader.h"
 #include "pose_file.h"
 
+#include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/spectral/spectral_bisection.h>
 
 #include <optional>
@@ -32,6 +33,7 @@ struct PartitionArgs {
   std::optional<int> max_depth;
   int threads = 0;
   std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
+  Refinement refine = Refinement::None;
   // the run
   bool force = false;
   bool quiet = false;

@@ -62,12 +62,20 @@ std::string topologyJson(const TopologicalMap& map) {
   std::vector<nlohmann::json> nodes, arcs;
   for (std::size_t k = 0; k < map.nodes.size(); ++k) {
     const auto& node = map.nodes[k];
+    std::vector<nlohmann::json> member_poses;
+    for (const auto& pose : node.member_poses) member_poses.push_back(poseToJson(pose));
     nodes.push_back({{"id", k}, {"reference", node.reference}, {"pose", poseToJson(node.pose)},
-                     {"members", node.members}});
+                     {"members", node.members}, {"member_poses", member_poses}});
   }
   for (const auto& arc : map.arcs)
-    arcs.push_back({{"from", arc.from}, {"to", arc.to}, {"weight", arc.weight}, {"pairs", arc.pairs},
-                    {"transform", poseToJson(arc.transform)}});
+    arcs.push_back({{"from", arc.from},
+                    {"to", arc.to},
+                    {"transform", poseToJson(arc.transform)},
+                    {"spread", {{"translation_m", arc.translation_spread}, {"rotation_rad", arc.rotation_spread}}},
+                    {"weight", arc.weight},
+                    {"pairs", arc.pairs},
+                    {"overlapping_pairs", arc.overlapping_pairs},
+                    {"sequence_pairs", arc.sequence_pairs}});
   return "{\n  \"nodes\": " + arrayPerLine(nodes) + ",\n  \"arcs\": " + arrayPerLine(arcs) + "\n}\n";
 }
 
@@ -75,11 +83,14 @@ std::string topologyDot(const TopologicalMap& map) {
   std::ostringstream out;
   out << "graph topology {\n  node [shape=box];\n";
   for (std::size_t k = 0; k < map.nodes.size(); ++k)
-    out << "  g" << k << " [label=\"group " << k << "\\n" << map.nodes[k].members.size() << " observations\"];\n";
+    out << "  g" << k << " [label=\"group " << k << "\\n" << map.nodes[k].members.size()
+        << " observations\\nreference " << map.nodes[k].reference << "\"];\n";
   for (const auto& arc : map.arcs) {
     const Eigen::Vector3d t = arc.transform.translation();
-    out << "  g" << arc.from << " -- g" << arc.to << " [label=\"W " << arc.weight << " (" << arc.pairs
-        << " pairs)\\n" << t.norm() << " m\"];\n";
+    out << "  g" << arc.from << " -- g" << arc.to << " [label=\"W " << arc.weight << ", " << arc.pairs
+        << " pairs\\n" << t.norm() << " m +- " << arc.translation_spread << "\"";
+    if (arc.overlapping_pairs == 0) out << ", style=dashed";  // joined only by the robot's path
+    out << "];\n";
   }
   out << "}\n";
   return out.str();

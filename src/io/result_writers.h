@@ -24,9 +24,10 @@ struct RunRecord {
 /// one group and one split per line.
 std::string partitionJson(const Partition& partition, const RunRecord& run);
 
-/// {"nodes": [{"id", "members", "reference", "pose"}], "arcs": [{"from", "to",
-/// "weight", "pairs", "transform"}]}; poses and transforms as x y z qw qx qy qz
-/// at full double precision.
+/// {"nodes": [{"id", "reference", "pose", "members", "member_poses"}], "arcs":
+/// [{"from", "to", "transform", "spread", "weight", "pairs", "overlapping_pairs",
+/// "sequence_pairs"}]}; poses and transforms as x y z qw qx qy qz at full
+/// double precision.
 std::string topologyJson(const TopologicalMap& map);
 
 /// The same graph in GraphViz DOT.
