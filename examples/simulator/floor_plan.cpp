@@ -205,4 +205,67 @@ std::vector<Pose2D> officeRoute(int count) {
   return poses;
 }
 
+FloorPlan loopBuilding() {
+  FloorPlan plan;
+  // Outer walls.
+  plan.addWallX(0.0, -0.1, 40.1);
+  plan.addWallX(26.0, -0.1, 40.1);
+  plan.addWallY(0.0, 0.0, 26.0);
+  plan.addWallY(40.0, 0.0, 26.0);
+  // The block of rooms inside the ring: doors on its south and north walls.
+  const double xs[] = {3.0, 14.33, 25.67, 37.0};
+  std::vector<std::pair<double, double>> doors;
+  for (int r = 0; r < 3; ++r) doors.emplace_back((xs[r] + xs[r + 1]) / 2 - 0.5, (xs[r] + xs[r + 1]) / 2 + 0.5);
+  plan.addWallX(3.0, 2.9, 37.1, doors);
+  plan.addWallX(23.0, 2.9, 37.1, doors);
+  plan.addWallY(3.0, 3.0, 23.0);
+  plan.addWallY(37.0, 3.0, 23.0);
+  plan.addWallX(13.0, 3.0, 37.0);  // between the south and north rooms
+  for (int r = 1; r < 3; ++r) plan.addWallY(xs[r], 3.0, 23.0);
+  // Furniture so that rooms and corridor stretches differ.
+  plan.addBox(5.0, 9.0, 7.0, 11.0);
+  plan.addBox(18.0, 5.0, 21.0, 6.0);
+  plan.addBox(31.0, 8.0, 32.0, 12.0);
+  plan.addBox(6.0, 16.0, 8.0, 17.0);
+  plan.addBox(20.0, 19.0, 22.0, 21.5);
+  plan.addBox(28.0, 15.0, 30.0, 16.5);
+  plan.addBox(19.8, 0.2, 20.2, 0.6);
+  plan.addBox(38.8, 12.8, 39.8, 13.2);
+  plan.addBox(19.8, 25.4, 20.2, 25.8);
+  for (int r = 0; r < 3; ++r) {
+    plan.addRoom("south room " + std::to_string(r + 1), xs[r], 3.0, xs[r + 1], 13.0);
+    plan.addRoom("north room " + std::to_string(r + 1), xs[r], 13.0, xs[r + 1], 23.0);
+  }
+  plan.addRoom("south corridor", 0.0, 0.0, 40.0, 3.0);
+  plan.addRoom("north corridor", 0.0, 23.0, 40.0, 26.0);
+  plan.addRoom("west corridor", 0.0, 3.0, 3.0, 23.0);
+  plan.addRoom("east corridor", 37.0, 3.0, 40.0, 23.0);
+  return plan;
+}
+
+std::vector<Pose2D> loopBuildingRoute(int count) {
+  const double xs[] = {3.0, 14.33, 25.67, 37.0};
+  std::vector<Eigen::Vector2d> waypoints{{1.5, 1.5}};
+  for (int r = 0; r < 3; ++r) {  // eastwards along the south corridor, into each south room
+    const double door = (xs[r] + xs[r + 1]) / 2;
+    waypoints.insert(waypoints.end(), {{door, 1.5}, {door, 5.0}, {door - 3.0, 8.0}, {door, 11.5},
+                                        {door + 3.0, 8.0}, {door, 5.0}, {door, 1.5}});
+  }
+  waypoints.emplace_back(38.5, 1.5);
+  waypoints.emplace_back(38.5, 24.5);
+  for (int r = 2; r >= 0; --r) {  // westwards along the north corridor, into each north room
+    const double door = (xs[r] + xs[r + 1]) / 2;
+    waypoints.insert(waypoints.end(), {{door, 24.5}, {door, 21.0}, {door + 3.0, 18.0}, {door, 14.5},
+                                        {door - 3.0, 18.0}, {door, 21.0}, {door, 24.5}});
+  }
+  waypoints.emplace_back(1.5, 24.5);
+  waypoints.emplace_back(1.5, 1.5);  // back where it started: the loop closes
+  waypoints.emplace_back(6.0, 1.5);
+  double length = 0.0;
+  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
+  std::vector<Pose2D> poses = samplePath(waypoints, length / count);
+  poses.resize(std::min<std::size_t>(poses.size(), count));
+  return poses;
+}
+
 }  // namespace obsgroup::sim

@@ -97,4 +97,11 @@ FloorPlan office();
 /// A route along the corridor that visits every room, `count` poses.
 std::vector<Pose2D> officeRoute(int count = 77);
 
+/// A larger building with a loop: a 3 m corridor ring around six rooms
+/// (40 x 26 m), each room with a door onto the ring.
+FloorPlan loopBuilding();
+/// A route around the whole ring that enters every room and closes the loop
+/// where it started, `count` poses.
+std::vector<Pose2D> loopBuildingRoute(int count = 260);
+
 }  // namespace obsgroup::sim
