@@ -4,15 +4,28 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 
 namespace obsgroup::sim {
 
+namespace {
+std::int64_t cellKey(long cx, long cy) { return (std::int64_t(cx) << 32) ^ (std::int64_t(cy) & 0xffffffff); }
+}  // namespace
+
 void FloorPlan::addBox(double x0, double y0, double x1, double y1) {
   const Eigen::Vector2d p00(x0, y0), p10(x1, y0), p11(x1, y1), p01(x0, y1);
-  segments_.push_back({p00, p10});
-  segments_.push_back({p10, p11});
-  segments_.push_back({p11, p01});
-  segments_.push_back({p01, p00});
+  for (const auto& [a, b] : {std::pair{p00, p10}, {p10, p11}, {p11, p01}, {p01, p00}}) {
+    segments_.push_back({a, b});
+    index(segments_.size() - 1);
+  }
+}
+
+void FloorPlan::index(std::size_t segment) {
+  const Segment& s = segments_[segment];
+  const long cx0 = long(std::floor(std::min(s.a.x(), s.b.x()) / kCell)), cx1 = long(std::floor(std::max(s.a.x(), s.b.x()) / kCell));
+  const long cy0 = long(std::floor(std::min(s.a.y(), s.b.y()) / kCell)), cy1 = long(std::floor(std::max(s.a.y(), s.b.y()) / kCell));
+  for (long cx = cx0; cx <= cx1; ++cx)
+    for (long cy = cy0; cy <= cy1; ++cy) cells_[cellKey(cx, cy)].push_back(static_cast<std::uint32_t>(segment));
 }
 
 namespace {
@@ -48,18 +61,41 @@ void FloorPlan::addRoom(std::string name, double x0, double y0, double x1, doubl
   room_names_.push_back(std::move(name));
 }
 
-double FloorPlan::castHorizontal(const Eigen::Vector2d& origin, double angle) const {
+double FloorPlan::castHorizontal(const Eigen::Vector2d& origin, double angle, double max_distance) const {
   const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
-  double best = std::numeric_limits<double>::infinity();
-  for (const Segment& s : segments_) {
+  const auto hit = [&](const Segment& s) {
     // origin + t dir = a + u (b - a), t > 0, u in [0, 1]
     const Eigen::Vector2d e = s.b - s.a;
     const double den = dir.x() * (-e.y()) - dir.y() * (-e.x());
-    if (std::abs(den) < 1e-12) continue;
+    if (std::abs(den) < 1e-12) return std::numeric_limits<double>::infinity();
     const Eigen::Vector2d r = s.a - origin;
     const double t = (r.x() * (-e.y()) - r.y() * (-e.x())) / den;
     const double u = (dir.x() * r.y() - dir.y() * r.x()) / den;
-    if (t > 1e-9 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+    return t > 1e-9 && u >= 0.0 && u <= 1.0 ? t : std::numeric_limits<double>::infinity();
+  };
+  // Walk the grid cells the ray crosses (Amanatides and Woo); stop at the
+  // first cell whose walls give a hit no further than the cell's far edge.
+  long cx = long(std::floor(origin.x() / kCell)), cy = long(std::floor(origin.y() / kCell));
+  const int step_x = dir.x() > 0 ? 1 : -1, step_y = dir.y() > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double delta_x = dir.x() != 0 ? kCell / std::abs(dir.x()) : inf;
+  const double delta_y = dir.y() != 0 ? kCell / std::abs(dir.y()) : inf;
+  double next_x = dir.x() != 0 ? ((cx + (step_x > 0)) * kCell - origin.x()) / dir.x() : inf;
+  double next_y = dir.y() != 0 ? ((cy + (step_y > 0)) * kCell - origin.y()) / dir.y() : inf;
+  double best = inf;
+  for (;;) {
+    const auto it = cells_.find(cellKey(cx, cy));
+    if (it != cells_.end())
+      for (std::uint32_t k : it->second) best = std::min(best, hit(segments_[k]));
+    const double leave = std::min(next_x, next_y);
+    if (best <= leave || leave > max_distance) break;
+    if (next_x < next_y) {
+      cx += step_x;
+      next_x += delta_x;
+    } else {
+      cy += step_y;
+      next_y += delta_y;
+    }
   }
   return best;
 }
@@ -70,7 +106,8 @@ std::vector<double> FloorPlan::scan(const Pose2D& pose, const LaserModel& laser,
   std::vector<double> ranges(laser.beams, laser.max_range);
   const double step = laser.beams > 1 ? laser.field_of_view / (laser.beams - 1) : 0.0;
   for (int k = 0; k < laser.beams; ++k) {
-    const double best = castHorizontal({pose.x, pose.y}, pose.yaw - laser.field_of_view / 2 + k * step);
+    const double best =
+        castHorizontal({pose.x, pose.y}, pose.yaw - laser.field_of_view / 2 + k * step, laser.max_range);
     const double n = laser.range_noise > 0 ? noise(rng) : 0.0;
     if (best < laser.max_range) ranges[k] = std::min(best + n, laser.max_range);
   }
@@ -88,7 +125,7 @@ std::vector<Eigen::Vector3d> FloorPlan::depthImage(const Pose2D& pose, const Dep
   for (int u = 0; u < camera.width; ++u) {
     // A pixel column shares one horizontal direction: one 2D cast per column.
     const double lateral = -(u - cx) / f;
-    const double wall = castHorizontal({pose.x, pose.y}, pose.yaw + std::atan(lateral));
+    const double wall = castHorizontal({pose.x, pose.y}, pose.yaw + std::atan(lateral), camera.max_range);
     for (int v = 0; v < camera.height; ++v) {
       const Eigen::Vector3d ray = Eigen::Vector3d(1.0, lateral, -(v - cy) / f).normalized();
       double s = wall / ray.head<2>().norm();  // the ray's length to the wall
@@ -201,6 +238,51 @@ std::vector<Pose2D> officeRoute(int count) {
   double length = 0.0;
   for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
   std::vector<Pose2D> poses = samplePath(waypoints, length / count);
+  poses.resize(std::min<std::size_t>(poses.size(), count));
+  return poses;
+}
+
+FloorPlan longBuilding(double length) {
+  FloorPlan plan;
+  // Corridor y in [6, 9]; rooms 8 m wide below (y 0..6) and above (y 9..15), one door each.
+  const int rooms = std::max(1, static_cast<int>(length / 8.0));
+  const double end = rooms * 8.0;
+  plan.addWallX(0.0, -0.1, end + 0.1);
+  plan.addWallX(15.0, -0.1, end + 0.1);
+  plan.addWallY(0.0, 0.0, 15.0);
+  plan.addWallY(end, 0.0, 15.0);
+  std::vector<std::pair<double, double>> doors;
+  for (int r = 0; r < rooms; ++r) doors.emplace_back(r * 8.0 + 3.5, r * 8.0 + 4.5);
+  plan.addWallX(6.0, 0.0, end, doors);
+  plan.addWallX(9.0, 0.0, end, doors);
+  for (int r = 1; r < rooms; ++r) {
+    plan.addWallY(r * 8.0, 0.0, 6.0);
+    plan.addWallY(r * 8.0, 9.0, 15.0);
+  }
+  for (int r = 0; r < rooms; ++r) {  // furniture that differs from room to room
+    const double x = r * 8.0, shift = (r * 37 % 5) * 0.8;
+    plan.addBox(x + 1.0 + shift, 1.0, x + 2.0 + shift, 2.2);
+    plan.addBox(x + 5.5 - shift * 0.5, 12.0, x + 6.5 - shift * 0.5, 13.5);
+    plan.addRoom("south room " + std::to_string(r + 1), x, 0.0, x + 8.0, 6.0);
+    plan.addRoom("north room " + std::to_string(r + 1), x, 9.0, x + 8.0, 15.0);
+  }
+  plan.addRoom("corridor", 0.0, 6.0, end, 9.0);
+  return plan;
+}
+
+std::vector<Pose2D> longBuildingRoute(double length, int count) {
+  const int rooms = std::max(1, static_cast<int>(length / 8.0));
+  std::vector<Eigen::Vector2d> waypoints{{1.0, 7.5}};
+  for (int r = 0; r < rooms; ++r) {
+    const double door = r * 8.0 + 4.0;
+    const double inside = r % 2 ? 12.0 : 3.0, doorway = r % 2 ? 10.0 : 5.0;  // alternate sides
+    waypoints.insert(waypoints.end(), {{door, 7.5}, {door, doorway}, {door - 2.0, inside}, {door + 2.0, inside},
+                                        {door, doorway}, {door, 7.5}});
+  }
+  waypoints.emplace_back(rooms * 8.0 - 1.0, 7.5);
+  double total = 0.0;
+  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) total += (waypoints[w + 1] - waypoints[w]).norm();
+  std::vector<Pose2D> poses = samplePath(waypoints, total / count);
   poses.resize(std::min<std::size_t>(poses.size(), count));
   return poses;
 }

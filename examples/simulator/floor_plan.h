@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace obsgroup::sim {
@@ -68,10 +69,15 @@ class FloorPlan {
   struct Room {
     double x0, y0, x1, y1;
   };
-  /// Distance along a horizontal ray to the first wall (infinity if none).
-  double castHorizontal(const Eigen::Vector2d& origin, double angle) const;
+  /// Distance along a horizontal ray to the first wall; infinity if none
+  /// lies within `max_distance` (the search may stop there).
+  double castHorizontal(const Eigen::Vector2d& origin, double angle, double max_distance) const;
 
+  /// Segments by grid cell, so that a ray only tests the walls near it.
+  void index(std::size_t segment);
+  static constexpr double kCell = 2.0;
   std::vector<Segment> segments_;
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
   double ceiling_ = 2.6;
   std::vector<Room> rooms_;
   std::vector<std::string> room_names_;
@@ -96,6 +102,14 @@ std::vector<Pose2D> threeRoomsPoses(int per_room = 5);
 FloorPlan office();
 /// A route along the corridor that visits every room, `count` poses.
 std::vector<Pose2D> officeRoute(int count = 77);
+
+/// A long building for scaling runs: `length` metres of 3 m corridor with
+/// 8 x 6 m rooms on both sides, each with a door; the local density of the
+/// map stays bounded however long it is.
+FloorPlan longBuilding(double length);
+/// A route along the corridor of longBuilding(length) that enters every
+/// room; `count` poses, evenly spaced.
+std::vector<Pose2D> longBuildingRoute(double length, int count);
 
 /// A larger building with a loop: a 3 m corridor ring around six rooms
 /// (40 x 26 m), each room with a door onto the ring.
