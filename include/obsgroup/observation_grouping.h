@@ -57,7 +57,11 @@ class ObservationGrouping {
   NeighbourSearch getNeighbourSearch() const { return overlap_.getNeighbourSearch(); }
   void setSearchMethod(const SearchMethodPtr& search) { overlap_.setSearchMethod(search); }
   SearchMethodPtr getSearchMethod() const { return overlap_.getSearchMethod(); }
-  void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
+  /// Threads for the overlap and the partition; the result does not depend on it.
+  void setNumberOfThreads(int threads) {
+    overlap_.setNumberOfThreads(threads);
+    options_.threads = threads;
+  }
   int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
   void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
 

@@ -1,6 +1,5 @@
 #include "obsgroup/graph/observation_graph.h"
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -45,21 +44,23 @@ Eigen::VectorXd degrees(const WeightMatrix& W) {
   return d;
 }
 
-WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members) {
+WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members, std::vector<int>& local_of) {
   const int m = static_cast<int>(members.size());
+  for (int k = 0; k < m; ++k) local_of[members[k]] = k;
   std::vector<Eigen::Triplet<double>> triplets;
-  for (int local_col = 0; local_col < m; ++local_col) {
-    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it) {
-      // members is sorted: a binary search keeps this O(nnz log m) with no O(N) scratch.
-      const auto pos = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
-      if (pos != members.end() && *pos == it.row())
-        triplets.emplace_back(static_cast<int>(pos - members.begin()), local_col, it.value());
-    }
-  }
+  for (int local_col = 0; local_col < m; ++local_col)
+    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it)
+      if (local_of[it.row()] >= 0) triplets.emplace_back(local_of[it.row()], local_col, it.value());
+  for (int i : members) local_of[i] = -1;
   WeightMatrix sub(m, m);
   sub.setFromTriplets(triplets.begin(), triplets.end());
   sub.makeCompressed();
   return sub;
+}
+
+WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members) {
+  std::vector<int> local_of(W.rows(), -1);
+  return inducedSubgraph(W, members, local_of);
 }
 
 std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W) {

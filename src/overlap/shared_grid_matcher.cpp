@@ -163,7 +163,7 @@ struct RowScratch {
   }
 };
 
-void countRow(const Grid& grid, const WorldPoints& world, int i, double delta_sq, RowScratch& s,
+void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDistance& within, RowScratch& s,
               std::vector<MatchCount>& row) {
   // Visit i's points cell by cell, so each neighbourhood is looked up once per cell.
   const std::size_t m = world.count(i);
@@ -198,7 +198,7 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, double delta_sq
           }
           ++s.tests;
           for (std::uint32_t q = run.begin; q < run.end; ++q) {
-            if (withinMatchDistance(p, grid.points()[q], delta_sq)) {
+            if (within(p, grid.points()[q])) {
               s.seen[j] = s.stamp;
               if (s.count[j]++ == 0) s.touched.push_back(j);
               break;
@@ -229,7 +229,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   out.rows.resize(n);
   if (n == 0) return out;
   const Grid grid(world, delta);
-  const double delta_sq = delta * delta;
+  const MatchDistance within(delta);
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
   std::uint64_t pairs = 0, tests = 0;
   std::atomic<std::size_t> done{0};
@@ -240,7 +240,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
     RowScratch scratch(n);
 #pragma omp for schedule(dynamic, 8)
     for (int i = 0; i < n; ++i) {
-      countRow(grid, world, i, delta_sq, scratch, out.rows[i]);
+      countRow(grid, world, i, within, scratch, out.rows[i]);
       const std::size_t now = ++done;
       if (progress && omp_get_thread_num() == 0) progress(now, n);
     }

@@ -1,7 +1,7 @@
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <algorithm>
-#include <deque>
+#include <omp.h>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -29,98 +29,129 @@ std::string toString(SplitNode::Outcome outcome) {
 
 namespace {
 
+/// What to do with one node of the split tree: its own fields, and the
+/// member lists of its children.
+struct Decision {
+  SplitNode node;  // members, parent and depth unchanged; the rest decided
+  std::vector<std::vector<int>> children;
+  int child_depth = 0;
+};
+
 class Partitioner {
  public:
   Partitioner(const WeightMatrix& W, const PartitionOptions& options) : W_(W), options_(options) {}
 
   Partition run() {
     const int n = static_cast<int>(W_.rows());
+    std::vector<int> frontier;
     if (n > 0) {
       SplitNode root;
       root.members.resize(n);
       for (int i = 0; i < n; ++i) root.members[i] = i;
-      addNode(std::move(root));
+      out_.splits.push_back(std::move(root));
+      frontier.push_back(0);
     }
-    // Breadth-first with a FIFO: the node order (and so the whole output) is
-    // deterministic, and deep recursions cannot overflow the stack.
-    while (!queue_.empty()) {
-      const int id = queue_.front();
-      queue_.pop_front();
-      process(id);
+    // Breadth-first, one level at a time: the nodes of a level are decided in
+    // parallel, then their children are numbered in level order, exactly as a
+    // FIFO would: the output is the same for any thread count, and deep
+    // recursions cannot overflow the stack.
+    const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+    while (!frontier.empty()) {
+      std::vector<Decision> decisions(frontier.size());
+      std::vector<std::string> errors(frontier.size());
+#pragma omp parallel num_threads(threads)
+      {
+        std::vector<int> local_of(n, -1);  // per-thread scratch of inducedSubgraph
+#pragma omp for schedule(dynamic, 1)
+        for (std::size_t k = 0; k < frontier.size(); ++k) {
+          try {
+            decisions[k] = decide(out_.splits[frontier[k]], local_of);
+          } catch (const std::exception& e) {
+            errors[k] = e.what();
+          }
+        }
+      }
+      for (const auto& e : errors)
+        if (!e.empty()) throw std::runtime_error(e);
+      std::vector<int> next;
+      for (std::size_t k = 0; k < frontier.size(); ++k) {
+        const int id = frontier[k];
+        Decision& d = decisions[k];
+        d.node.members = std::move(out_.splits[id].members);
+        d.node.parent = out_.splits[id].parent;
+        d.node.depth = out_.splits[id].depth;
+        out_.splits[id] = std::move(d.node);
+        for (auto& members : d.children) {
+          SplitNode child;
+          child.members = std::move(members);
+          child.parent = id;
+          child.depth = d.child_depth;
+          out_.splits[id].children.push_back(static_cast<int>(out_.splits.size()));
+          next.push_back(static_cast<int>(out_.splits.size()));
+          out_.splits.push_back(std::move(child));
+        }
+      }
+      frontier = std::move(next);
     }
     return collect(n);
   }
 
  private:
-  void addNode(SplitNode node) {
-    queue_.push_back(static_cast<int>(out_.splits.size()));
-    out_.splits.push_back(std::move(node));
-  }
-
-  void addChild(int parent, std::vector<int> members, int depth) {
-    SplitNode child;
-    child.members = std::move(members);
-    child.parent = parent;
-    child.depth = depth;
-    out_.splits[parent].children.push_back(static_cast<int>(out_.splits.size()));
-    addNode(std::move(child));
-  }
-
-  void process(int id) {
-    const std::vector<int> members = out_.splits[id].members;  // copy: out_.splits grows below
-    const int depth = out_.splits[id].depth;
-    if (members.size() < 2) return;  // Leaf / TooFewNodes by default
-    const WeightMatrix sub = inducedSubgraph(W_, members);
+  Decision decide(const SplitNode& current, std::vector<int>& local_of) const {
+    Decision d;
+    const std::vector<int>& members = current.members;
+    d.child_depth = current.depth;
+    if (members.size() < 2) return d;  // Leaf / TooFewNodes by default
+    const WeightMatrix sub = inducedSubgraph(W_, members, local_of);
 
     // A disconnected graph is split into its components first: their Ncut is
     // 0, and the eigensolver then never meets a repeated zero eigenvalue.
     auto components = connectedComponents(sub);
     if (components.size() > 1) {
-      SplitNode& node = out_.splits[id];
-      node.kind = SplitNode::Kind::Components;
-      node.outcome = SplitNode::Outcome::Accepted;
-      node.accepted = true;
-      node.ncut = 0.0;
+      d.node.kind = SplitNode::Kind::Components;
+      d.node.outcome = SplitNode::Outcome::Accepted;
+      d.node.accepted = true;
+      d.node.ncut = 0.0;
       for (auto& component : components) {
         for (int& local : component) local = members[local];
-        addChild(id, std::move(component), depth);
+        d.children.push_back(std::move(component));
       }
-      return;
+      return d;
     }
 
     const int min_size = std::max(1, options_.min_group_size);
-    if (static_cast<int>(members.size()) < 2 * min_size) return;  // TooFewNodes
-    if (depth >= options_.max_depth) {
-      out_.splits[id].outcome = SplitNode::Outcome::MaxDepth;
-      return;
+    if (static_cast<int>(members.size()) < 2 * min_size) return d;  // TooFewNodes
+    if (current.depth >= options_.max_depth) {
+      d.node.outcome = SplitNode::Outcome::MaxDepth;
+      return d;
     }
 
     Bisection b = spectralBisection(sub, options_.split, options_.eigen, min_size);
-    SplitNode& node = out_.splits[id];
-    node.attempted = true;
-    node.ncut = b.cut.ncut;
-    node.threshold = b.threshold;
-    node.eigenvalue = b.fiedler.eigenvalue;
-    node.sparse_solver = b.fiedler.sparse;
-    if (options_.keep_eigenvectors) node.eigenvector = std::move(b.fiedler.y);
+    d.node.attempted = true;
+    d.node.ncut = b.cut.ncut;
+    d.node.threshold = b.threshold;
+    d.node.eigenvalue = b.fiedler.eigenvalue;
+    d.node.sparse_solver = b.fiedler.sparse;
+    if (options_.keep_eigenvectors) d.node.eigenvector = std::move(b.fiedler.y);
 
     std::vector<int> a, rest;
     for (std::size_t k = 0; k < members.size(); ++k) (b.in_a[k] ? a : rest).push_back(members[k]);
     if (!b.valid) {
-      node.outcome = SplitNode::Outcome::NoSplit;
+      d.node.outcome = SplitNode::Outcome::NoSplit;
     } else if (!(b.cut.ncut < options_.ncut_threshold)) {
-      node.outcome = SplitNode::Outcome::NcutAboveThreshold;
+      d.node.outcome = SplitNode::Outcome::NcutAboveThreshold;
     } else if (static_cast<int>(a.size()) < min_size || static_cast<int>(rest.size()) < min_size) {
-      node.outcome = SplitNode::Outcome::GroupTooSmall;
+      d.node.outcome = SplitNode::Outcome::GroupTooSmall;
     } else {
-      node.kind = SplitNode::Kind::Bisection;
-      node.outcome = SplitNode::Outcome::Accepted;
-      node.accepted = true;
+      d.node.kind = SplitNode::Kind::Bisection;
+      d.node.outcome = SplitNode::Outcome::Accepted;
+      d.node.accepted = true;
       // The side holding the smallest observation comes first.
       if (rest.front() < a.front()) std::swap(a, rest);
-      addChild(id, std::move(a), depth + 1);
-      addChild(id, std::move(rest), depth + 1);
+      d.children = {std::move(a), std::move(rest)};
+      d.child_depth = current.depth + 1;
     }
+    return d;
   }
 
   Partition collect(int n) {
@@ -137,7 +168,6 @@ class Partitioner {
   const WeightMatrix& W_;
   const PartitionOptions& options_;
   Partition out_;
-  std::deque<int> queue_;
 };
 
 }  // namespace

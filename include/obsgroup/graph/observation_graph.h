@@ -42,6 +42,9 @@ Eigen::VectorXd degrees(const WeightMatrix& W);
 /// The subgraph of W induced by `members` (sorted ascending, unique), in
 /// local indices 0..members.size()-1.
 WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members);
+/// The same with caller-owned scratch: `local_of` has W.rows() entries, all
+/// -1, and is left so; repeated calls then cost O(nnz of the members' columns).
+WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members, std::vector<int>& local_of);
 
 /// Connected components of W (the diagonal is ignored): each component sorted
 /// ascending, components ordered by their smallest node.

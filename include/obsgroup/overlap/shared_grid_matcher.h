@@ -13,7 +13,7 @@ namespace obsgroup {
 ///
 /// The grid's cells are a hair larger than delta, so two points within delta
 /// always fall in the same or adjacent cells whatever the rounding of the
-/// cell index; the match itself is decided by withinMatchDistance(). Each
+/// cell index; the match itself is decided by MatchDistance. Each
 /// point is tested against the 3x3 (flat data) or 3x3x3 neighbouring cells,
 /// and each nearby observation is counted at most once per point. Rows are
 /// independent, so the result is the same for any number of threads.

@@ -23,6 +23,9 @@ struct PartitionOptions {
   int max_depth = std::numeric_limits<int>::max();
   /// Keep each node's eigenvector in the split tree (for plots and analysis).
   bool keep_eigenvectors = true;
+  /// Threads over the nodes of one level of the split tree (0: OpenMP's
+  /// default). The result is the same for any value.
+  int threads = 0;
   FiedlerOptions eigen;
 };
 

@@ -110,7 +110,7 @@ std::vector<MatchCount> countColumnPclSearch(pcl::search::Search<PointT>& search
     (*target)[k].z = q.z();
   }
   search.setInputCloud(target);
-  const double delta_sq = delta * delta;
+  const MatchDistance within(delta);
   const double radius = delta * (1.0 + 1e-5);
   pcl::Indices indices;
   std::vector<float> sq_distances;
@@ -126,10 +126,10 @@ std::vector<MatchCount> countColumnPclSearch(pcl::search::Search<PointT>& search
       // The nearest neighbour decides, unless float rounding put it just
       // outside delta: then every neighbour in the radius is checked.
       if (search.radiusSearch(query, radius, indices, sq_distances, 1) == 0) continue;
-      bool match = withinMatchDistance(*p, world.begin(j)[indices[0]], delta_sq);
+      bool match = within(*p, world.begin(j)[indices[0]]);
       if (!match) {
         search.radiusSearch(query, radius, indices, sq_distances, 0);
-        for (const auto k : indices) match = match || withinMatchDistance(*p, world.begin(j)[k], delta_sq);
+        for (const auto k : indices) match = match || within(*p, world.begin(j)[k]);
       }
       count += match;
     }
