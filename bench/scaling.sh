@@ -67,19 +67,21 @@ sizes="1000 10000 100000"
     echo
     echo "| input | N | obsgroup wall s | obsgroup groups | MRPT wall s | MRPT groups | MRPT / obsgroup |"
     echo "|---|---|---|---|---|---|---|"
-    for name in tile_sep_0600 tile_ovl_0300 tile_sep_1200 tile_ovl_1200 tile_sep_2400 tile_ovl_2400; do
+    for name in tile_sep_0600 tile_ovl_0300 tile_sep_1200 tile_sep_2400 tile_ovl_2400; do
       dir=$shared/data/scaling/$name
       /usr/bin/time -v -o "$work/time_$name" "$exe" partition "$dir/$name.clf" -o "$work/out_$name" --force -q \
         --no-pictures --delta 0.2 --ncut-threshold 0.9
       ours=$(awk -F': ' '/Elapsed \(wall clock\)/{n=split($2,t,":"); s=0; for(i=1;i<=n;i++) s=s*60+t[i]; print s}' "$work/time_$name")
       groups=$(python3 -c "import json;print(len(json.load(open('$work/out_$name/partition.json'))['groups']))")
-      case $name in *2400) limit=600 ;; *) limit=300 ;; esac
+      # MRPT at 2400 scans runs for many minutes (peer/mrpt/README.md: not finished after 319 s):
+      # it is stopped at 120 s here, and the ratio is then a lower bound.
+      limit=120
       mrpt=$(timeout $limit "$shared/peer/mrpt/time_mrpt.sh" -r 1 "$dir/$name.simplemap.gz" 2>/dev/null | tail -1 || true)
       if [ -n "$mrpt" ] && [ "$(echo "$mrpt" | awk '{print $1}')" = "$name" ]; then
         mwall=$(echo "$mrpt" | awk '{print $4}'); mgroups=$(echo "$mrpt" | awk '{print $3}')
         ratio=$(awk -v a="$mwall" -v b="$ours" 'BEGIN{printf "%.0f", a/b}')
       else
-        mwall="not finished in ${limit} s"; mgroups="-"; ratio="> $(awk -v a=$limit -v b="$ours" 'BEGIN{printf "%.0f", a/b}')"
+        mwall="stopped at ${limit} s"; mgroups="-"; ratio="> $(awk -v a=$limit -v b="$ours" 'BEGIN{printf "%.0f", a/b}')"
       fi
       n=${name##*_}; echo "| $name | $((10#$n)) | $ours | $groups | $mwall | $mgroups | $ratio |"
     done
