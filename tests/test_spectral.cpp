@@ -61,6 +61,30 @@ TEST(Fiedler, DenseAndSparseAgreeOnAThousandNodes) {
   }
 }
 
+TEST(Fiedler, DenseAndSparseAgreeOnADenseGraph) {
+  // Heavily overlapping observations give dense graphs: every pair linked,
+  // three clusters. Spectra then works on the normalized adjacency (no
+  // factorisation); it must agree with the dense solver all the same.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> weight(0.5, 1.0);
+  std::vector<WeightedPair> pairs;
+  const int n = 300;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) pairs.push_back({i, j, weight(rng) * ((i * 3) / n == (j * 3) / n ? 1.0 : 0.05)});
+  const WeightMatrix W = buildWeightMatrix(n, pairs);
+  FiedlerOptions dense_options, sparse_options;
+  dense_options.solver = EigenSolver::Dense;
+  sparse_options.solver = EigenSolver::Sparse;
+  const FiedlerResult dense = fiedlerVector(W, dense_options);
+  const FiedlerResult sparse = fiedlerVector(W, sparse_options);
+  EXPECT_TRUE(sparse.sparse);
+  EXPECT_LT(residual(W, sparse), 1e-8);
+  EXPECT_NEAR(dense.eigenvalue, sparse.eigenvalue, 1e-10);
+  EXPECT_LT((dense.y - sparse.y).cwiseAbs().maxCoeff(), 1e-6 * dense.y.cwiseAbs().maxCoeff());
+  EXPECT_EQ(spectralBisection(W, SplitCriterion::Mean, dense_options).in_a,
+            spectralBisection(W, SplitCriterion::Mean, sparse_options).in_a);
+}
+
 TEST(Fiedler, IsTheSecondSmallestGeneralizedEigenvector) {
   const WeightMatrix W = routeGraph(60, 4, 3);
   const FiedlerResult f = fiedlerVector(W, {EigenSolver::Dense});
