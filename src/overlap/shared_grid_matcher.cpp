@@ -147,8 +147,9 @@ class Grid {
 /// Per-thread scratch for one row of counts: dense by observation, reset only
 /// where touched, so a row costs O(matches), not O(N).
 struct RowScratch {
-  explicit RowScratch(int n) : seen(n, 0), tested(n, -1), count(n, 0) {}
-  std::vector<std::uint32_t> seen;  // point stamp of the last match with j
+  explicit RowScratch(int n) : seen(n, 0), probed(n, 0), tested(n, -1), count(n, 0) {}
+  std::vector<std::uint32_t> seen;    // point stamp of the last match with j
+  std::vector<std::uint32_t> probed;  // point stamp of the last test against j
   std::vector<int> tested;          // last row i that compared points with j
   std::vector<std::uint32_t> count;
   std::vector<int> touched;
@@ -158,6 +159,7 @@ struct RowScratch {
   void nextPoint() {
     if (++stamp == 0) {  // wrapped: forget old stamps
       std::fill(seen.begin(), seen.end(), 0);
+      std::fill(probed.begin(), probed.end(), 0);
       stamp = 1;
     }
   }
@@ -196,7 +198,10 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDist
             s.tested[j] = i;
             ++s.pairs;
           }
-          ++s.tests;
+          if (s.probed[j] != s.stamp) {  // one point-to-observation test, over all of j's nearby runs
+            s.probed[j] = s.stamp;
+            ++s.tests;
+          }
           for (std::uint32_t q = run.begin; q < run.end; ++q) {
             if (within(p, grid.points()[q])) {
               s.seen[j] = s.stamp;

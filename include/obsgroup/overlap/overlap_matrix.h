@@ -27,7 +27,7 @@ using ProgressCallback = std::function<void(std::size_t done, std::size_t total)
 struct MatchCounts {
   std::vector<std::vector<MatchCount>> rows;
   std::uint64_t pairs_evaluated = 0;  ///< Ordered pairs (i, j) whose points were compared.
-  std::uint64_t point_tests = 0;      ///< Point-to-observation tests (one per point i and nearby j).
+  std::uint64_t point_tests = 0;      ///< Point-to-observation tests: one per point of i and observation j with points near it.
 };
 
 /// The sensed-space overlap of a set of observations.
