@@ -7,6 +7,7 @@
 // The route is about 0.2 m of building per scan, so 10,000 scans cover 2 km.
 
 #include "floor_plan.h"
+#include "to_cloud.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -68,14 +69,9 @@ int write3D(int n, const std::string& folder) {
   std::filesystem::create_directories(folder);
 #pragma omp parallel for schedule(dynamic, 8)
   for (std::size_t k = 0; k < route.size(); ++k) {
-    const Pose2D& p = route[k];
-    pcl::PointCloud<pcl::PointXYZ> cloud;
-    for (const auto& q : plan.depthImage(p, camera, k)) cloud.push_back(pcl::PointXYZ(float(q.x()), float(q.y()), float(q.z())));
-    cloud.sensor_origin_ << float(p.x), float(p.y), float(camera.height_above_floor), 0.0f;
-    cloud.sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(p.yaw), Eigen::Vector3f::UnitZ()));
     char name[32];
     std::snprintf(name, sizeof name, "/%06zu.pcd", k);
-    pcl::io::savePCDFileBinary(folder + name, cloud);
+    pcl::io::savePCDFileBinary(folder + name, *depthCloud<pcl::PointXYZ>(plan, route[k], camera, k));
   }
   std::cout << "wrote " << route.size() << " depth clouds of a " << length << " m building to " << folder << "\n";
   return 0;

@@ -9,6 +9,7 @@
 // The output is deterministic; a test regenerates it and compares with data/.
 
 #include "floor_plan.h"
+#include "to_cloud.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -80,12 +81,8 @@ void writeOffice3D(const fs::path& folder) {
   char buffer[160];
   for (std::size_t k = 0; k < route.size(); ++k) {
     const Pose2D& p = route[k];
-    pcl::PointCloud<pcl::PointXYZ> cloud;
-    for (const auto& q : plan.depthImage(p, camera, k)) cloud.push_back(pcl::PointXYZ(float(q.x()), float(q.y()), float(q.z())));
-    cloud.sensor_origin_ << float(p.x), float(p.y), float(camera.height_above_floor), 0.0f;
-    cloud.sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(p.yaw), Eigen::Vector3f::UnitZ()));
     std::snprintf(buffer, sizeof buffer, "%06zu.pcd", k);
-    pcl::io::savePCDFileBinaryCompressed((folder / "pcd" / buffer).string(), cloud);
+    pcl::io::savePCDFileBinaryCompressed((folder / "pcd" / buffer).string(), *depthCloud<pcl::PointXYZ>(plan, p, camera, k));
     std::snprintf(buffer, sizeof buffer, "%.1f %.9f %.9f %.9f 0 0 %.12f %.12f\n", k * 0.5, p.x, p.y,
                   camera.height_above_floor, std::sin(p.yaw / 2), std::cos(p.yaw / 2));
     poses << buffer;

@@ -175,6 +175,14 @@ std::vector<Pose2D> samplePath(const std::vector<Eigen::Vector2d>& waypoints, do
   return poses;
 }
 
+std::vector<Pose2D> evenlySpaced(const std::vector<Eigen::Vector2d>& waypoints, int count) {
+  double length = 0.0;
+  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
+  std::vector<Pose2D> poses = samplePath(waypoints, length / count);
+  poses.resize(std::min<std::size_t>(poses.size(), count));
+  return poses;
+}
+
 FloorPlan threeRooms() {
   FloorPlan plan;
   plan.addWallX(0.0, -0.1, 18.1);
@@ -235,11 +243,7 @@ std::vector<Pose2D> officeRoute(int count) {
                                         {door + 2.5, 5.5}, {door, 4.0}, {door, 1.25}});
   }
   waypoints.emplace_back(31.0, 1.25);
-  double length = 0.0;
-  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
-  std::vector<Pose2D> poses = samplePath(waypoints, length / count);
-  poses.resize(std::min<std::size_t>(poses.size(), count));
-  return poses;
+  return evenlySpaced(waypoints, count);
 }
 
 FloorPlan longBuilding(double length) {
@@ -280,11 +284,7 @@ std::vector<Pose2D> longBuildingRoute(double length, int count) {
                                         {door, doorway}, {door, 7.5}});
   }
   waypoints.emplace_back(rooms * 8.0 - 1.0, 7.5);
-  double total = 0.0;
-  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) total += (waypoints[w + 1] - waypoints[w]).norm();
-  std::vector<Pose2D> poses = samplePath(waypoints, total / count);
-  poses.resize(std::min<std::size_t>(poses.size(), count));
-  return poses;
+  return evenlySpaced(waypoints, count);
 }
 
 FloorPlan loopBuilding() {
@@ -343,11 +343,7 @@ std::vector<Pose2D> loopBuildingRoute(int count) {
   waypoints.emplace_back(1.5, 24.5);
   waypoints.emplace_back(1.5, 1.5);  // back where it started: the loop closes
   waypoints.emplace_back(6.0, 1.5);
-  double length = 0.0;
-  for (std::size_t w = 0; w + 1 < waypoints.size(); ++w) length += (waypoints[w + 1] - waypoints[w]).norm();
-  std::vector<Pose2D> poses = samplePath(waypoints, length / count);
-  poses.resize(std::min<std::size_t>(poses.size(), count));
-  return poses;
+  return evenlySpaced(waypoints, count);
 }
 
 }  // namespace obsgroup::sim

@@ -89,6 +89,8 @@ std::vector<Eigen::Vector2d> scanToPoints(const std::vector<double>& ranges, con
 
 /// Poses every `spacing` metres along a polyline, heading along the path.
 std::vector<Pose2D> samplePath(const std::vector<Eigen::Vector2d>& waypoints, double spacing);
+/// At most `count` poses evenly spaced along a polyline.
+std::vector<Pose2D> evenlySpaced(const std::vector<Eigen::Vector2d>& waypoints, int count);
 
 /// Three 6 x 5 m rooms in a row joined by 1 m doors (the situation of the
 /// paper's Fig. 3).

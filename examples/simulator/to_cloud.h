@@ -23,4 +23,23 @@ typename pcl::PointCloud<PointT>::Ptr toCloud(const std::vector<Eigen::Vector2d>
   return cloud;
 }
 
+/// One depth image of `plan` as a cloud in the camera frame, its pose (the
+/// camera standing over `pose`) in the cloud's sensor origin and orientation,
+/// as a PCD file's VIEWPOINT stores it.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr depthCloud(const FloorPlan& plan, const Pose2D& pose, const DepthCamera& camera,
+                                                 std::uint64_t seed) {
+  typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+  for (const auto& q : plan.depthImage(pose, camera, seed)) {
+    PointT p;
+    p.x = static_cast<float>(q.x());
+    p.y = static_cast<float>(q.y());
+    p.z = static_cast<float>(q.z());
+    cloud->push_back(p);
+  }
+  cloud->sensor_origin_ << float(pose.x), float(pose.y), float(camera.height_above_floor), 0.0f;
+  cloud->sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(pose.yaw), Eigen::Vector3f::UnitZ()));
+  return cloud;
+}
+
 }  // namespace obsgroup::sim

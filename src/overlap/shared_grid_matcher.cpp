@@ -147,9 +147,10 @@ class Grid {
 /// Per-thread scratch for one row of counts: dense by observation, reset only
 /// where touched, so a row costs O(matches), not O(N).
 struct RowScratch {
-  explicit RowScratch(int n) : seen(n, 0), probed(n, 0), tested(n, -1), count(n, 0) {}
+  explicit RowScratch(int n) : seen(n, 0), nearby(n, 0), tested(n, -1), count(n, 0) {}
   std::vector<std::uint32_t> seen;    // point stamp of the last match with j
-  std::vector<std::uint32_t> probed;  // point stamp of the last test against j
+  std::vector<std::uint64_t> nearby;  // cell stamp of the last cell near j
+  std::uint64_t cell_stamp = 0;
   std::vector<int> tested;          // last row i that compared points with j
   std::vector<std::uint32_t> count;
   std::vector<int> touched;
@@ -159,7 +160,6 @@ struct RowScratch {
   void nextPoint() {
     if (++stamp == 0) {  // wrapped: forget old stamps
       std::fill(seen.begin(), seen.end(), 0);
-      std::fill(probed.begin(), probed.end(), 0);
       stamp = 1;
     }
   }
@@ -186,22 +186,31 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDist
           if (runs.first != runs.second) neighbourhood[used++] = runs;
         }
     std::size_t last = first;
-    for (; last < m && cells[last].first == c; ++last) {
-      const Eigen::Vector3f& p = world.begin(i)[cells[last].second];
+    while (last < m && cells[last].first == c) ++last;
+    // Every point of the cell is tested once against every other observation
+    // with points in the neighbourhood (a match ends the test early).
+    ++s.cell_stamp;
+    std::uint64_t observations_near = 0;
+    for (int h = 0; h < used; ++h)
+      for (std::uint32_t r = neighbourhood[h].first; r < neighbourhood[h].second; ++r) {
+        const int j = grid.runs()[r].observation;
+        if (j == i || s.nearby[j] == s.cell_stamp) continue;
+        s.nearby[j] = s.cell_stamp;
+        ++observations_near;
+        if (s.tested[j] != i) {
+          s.tested[j] = i;
+          ++s.pairs;
+        }
+      }
+    s.tests += observations_near * (last - first);
+    for (std::size_t k = first; k < last; ++k) {
+      const Eigen::Vector3f& p = world.begin(i)[cells[k].second];
       s.nextPoint();
       for (int h = 0; h < used; ++h) {
         for (std::uint32_t r = neighbourhood[h].first; r < neighbourhood[h].second; ++r) {
           const Run& run = grid.runs()[r];
           const int j = run.observation;
           if (j == i || s.seen[j] == s.stamp) continue;  // each j counted once per point
-          if (s.tested[j] != i) {
-            s.tested[j] = i;
-            ++s.pairs;
-          }
-          if (s.probed[j] != s.stamp) {  // one point-to-observation test, over all of j's nearby runs
-            s.probed[j] = s.stamp;
-            ++s.tests;
-          }
           for (std::uint32_t q = run.begin; q < run.end; ++q) {
             if (within(p, grid.points()[q])) {
               s.seen[j] = s.stamp;
