@@ -79,7 +79,11 @@ class DeflatedNormalizedAdjacency {
   Eigen::VectorXd z0_;
 };
 
-/// Average number of neighbours above which the adjacency form is tried first.
+/// A graph is dense, and the adjacency form tried first, when each node links
+/// to at least this share of the others (and to at least 48 of them): then
+/// a Cholesky factor would fill in, and the spectral gap is wide. Long
+/// route-like graphs have tiny gaps, where plain Lanczos stalls.
+constexpr double kDenseGraphShare = 0.125;
 constexpr double kDenseGraphDegree = 48.0;
 
 template <typename Operator>
@@ -135,7 +139,8 @@ FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options
                            (options.solver == EigenSolver::Auto && n > options.dense_max_size);
   if (want_sparse && n > 2) {
     const int ncv = static_cast<int>(std::min<Eigen::Index>(n, 20));
-    const bool dense_graph = double(W.nonZeros()) / double(n) >= kDenseGraphDegree;
+    const double degree = double(W.nonZeros()) / double(n);
+    const bool dense_graph = degree >= kDenseGraphDegree && degree >= kDenseGraphShare * double(n);
     result.sparse = (dense_graph && solveSparse<DeflatedNormalizedAdjacency>(L, z0, options, ncv, z)) ||
                     solveSparse<DeflatedLaplacianInverse>(L, z0, options, ncv, z) ||
                     solveSparse<DeflatedLaplacianInverse>(L, z0, options, static_cast<int>(std::min<Eigen::Index>(n, 80)), z);
