@@ -30,6 +30,12 @@ struct Run {
   std::uint32_t begin, end;  // into Grid::points
 };
 
+/// What the grid knows of one cell.
+struct CellRuns {
+  std::uint32_t begin = 0, end = 0;  ///< the cell's runs, [begin, end) into the run array
+  std::uint32_t ordinal = 0;         ///< the cell's number, in key order
+};
+
 /// Open-addressing hash table from a cell to its runs. Built once, read-only
 /// afterwards, so all threads share it without locks.
 class CellTable {
@@ -40,24 +46,24 @@ class CellTable {
     mask_ = capacity - 1;
     slots_.assign(capacity, Slot{});
   }
-  void insert(const CellKey& key, std::uint32_t run_begin, std::uint32_t run_end) {
+  void insert(const CellKey& key, const CellRuns& runs) {
     std::size_t s = hash(key) & mask_;
-    while (slots_[s].run_end != 0) s = (s + 1) & mask_;
-    slots_[s] = Slot{key, run_begin, run_end};
+    while (slots_[s].runs.end != 0) s = (s + 1) & mask_;
+    slots_[s] = Slot{key, runs};
   }
-  /// Runs of a cell as [begin, end) into the run array; begin == end if empty.
-  std::pair<std::uint32_t, std::uint32_t> find(const CellKey& key) const {
+  /// The cell's runs; begin == end if the cell is empty.
+  CellRuns find(const CellKey& key) const {
     for (std::size_t s = hash(key) & mask_;; s = (s + 1) & mask_) {
       const Slot& slot = slots_[s];
-      if (slot.run_end == 0) return {0, 0};
-      if (slot.key == key) return {slot.run_begin, slot.run_end};
+      if (slot.runs.end == 0) return {};
+      if (slot.key == key) return slot.runs;
     }
   }
 
  private:
   struct Slot {
     CellKey key{0, 0, 0};
-    std::uint32_t run_begin = 0, run_end = 0;  // run_end == 0 marks a free slot
+    CellRuns runs;  // runs.end == 0 marks a free slot
   };
   static std::size_t hash(const CellKey& k) {
     std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ull;
@@ -92,6 +98,19 @@ class Grid {
 
   bool flat() const { return flat_; }
   const CellTable& table() const { return table_; }
+  /// Distinct observations with points in the neighbourhood of a cell (by ordinal).
+  std::uint32_t observationsNear(std::uint32_t ordinal) const { return observations_near_[ordinal]; }
+  /// Calls f(runs) for each non-empty cell of the 3x3 (flat) or 3x3x3 neighbourhood of c.
+  template <typename F>
+  void forEachNeighbour(const CellKey& c, F&& f) const {
+    const int dz_max = flat_ ? 0 : 1;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -dz_max; dz <= dz_max; ++dz) {
+          const CellRuns runs = table_.find({c.x + dx, c.y + dy, c.z + dz});
+          if (runs.begin != runs.end) f(runs);
+        }
+  }
   const std::vector<Run>& runs() const { return runs_; }
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
 
@@ -124,16 +143,50 @@ class Grid {
       if (k == 0 || !(entries[k].key == entries[k - 1].key)) ++cells;
     }
     table_.reserve(cells);
-    std::size_t cell_first_run = 0;
+    std::vector<CellKey> keys;
+    keys.reserve(cells);
+    std::uint32_t cell_first_run = 0;
+    const auto close_cell = [&](const CellKey& key) {
+      table_.insert(key, {cell_first_run, static_cast<std::uint32_t>(runs_.size()),
+                          static_cast<std::uint32_t>(keys.size())});
+      keys.push_back(key);
+    };
     for (std::size_t k = 0; k < total; ++k) {
       const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
-      if (new_cell && k > 0) table_.insert(entries[k - 1].key, cell_first_run, runs_.size());
-      if (new_cell) cell_first_run = runs_.size();
+      if (new_cell && k > 0) close_cell(entries[k - 1].key);
+      if (new_cell) cell_first_run = static_cast<std::uint32_t>(runs_.size());
       if (new_cell || entries[k].observation != entries[k - 1].observation)
         runs_.push_back(Run{entries[k].observation, static_cast<std::uint32_t>(k), 0});
       runs_.back().end = static_cast<std::uint32_t>(k + 1);
     }
-    if (total > 0) table_.insert(entries[total - 1].key, cell_first_run, runs_.size());
+    if (total > 0) close_cell(entries[total - 1].key);
+    countObservationsNear(keys);
+  }
+
+  /// For each cell, the distinct observations in its neighbourhood: every
+  /// point of the cell is tested once against each of them but its own, so
+  /// the work statistic costs nothing in the per-point loop.
+  void countObservationsNear(const std::vector<CellKey>& keys) {
+    observations_near_.assign(keys.size(), 0);
+#pragma omp parallel
+    {
+      std::vector<std::uint32_t> stamp(world_.size(), 0);
+#pragma omp for schedule(dynamic, 256)
+      for (std::size_t c = 0; c < keys.size(); ++c) {
+        std::uint32_t distinct = 0;
+        const std::uint32_t mark = static_cast<std::uint32_t>(c + 1);
+        forEachNeighbour(keys[c], [&](const CellRuns& runs) {
+          for (std::uint32_t r = runs.begin; r < runs.end; ++r) {
+            std::uint32_t& s = stamp[runs_[r].observation];
+            if (s != mark) {
+              s = mark;
+              ++distinct;
+            }
+          }
+        });
+        observations_near_[c] = distinct;
+      }
+    }
   }
 
   const WorldPoints& world_;
@@ -142,15 +195,14 @@ class Grid {
   CellTable table_;
   std::vector<Run> runs_;
   std::vector<Eigen::Vector3f> points_;
+  std::vector<std::uint32_t> observations_near_;
 };
 
 /// Per-thread scratch for one row of counts: dense by observation, reset only
 /// where touched, so a row costs O(matches), not O(N).
 struct RowScratch {
-  explicit RowScratch(int n) : seen(n, 0), nearby(n, 0), tested(n, -1), count(n, 0) {}
-  std::vector<std::uint32_t> seen;    // point stamp of the last match with j
-  std::vector<std::uint64_t> nearby;  // cell stamp of the last cell near j
-  std::uint64_t cell_stamp = 0;
+  explicit RowScratch(int n) : seen(n, 0), tested(n, -1), count(n, 0) {}
+  std::vector<std::uint32_t> seen;  // point stamp of the last match with j
   std::vector<int> tested;          // last row i that compared points with j
   std::vector<std::uint32_t> count;
   std::vector<int> touched;
@@ -174,43 +226,27 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDist
   std::sort(cells.begin(), cells.end(), [](const auto& a, const auto& b) {
     return a.first == b.first ? a.second < b.second : a.first < b.first;
   });
-  const int dz_max = grid.flat() ? 0 : 1;
-  std::array<std::pair<std::uint32_t, std::uint32_t>, 27> neighbourhood;
+  std::array<CellRuns, 27> neighbourhood;
   for (std::size_t first = 0; first < m;) {
     const CellKey c = cells[first].first;
     int used = 0;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -dz_max; dz <= dz_max; ++dz) {
-          const auto runs = grid.table().find({c.x + dx, c.y + dy, c.z + dz});
-          if (runs.first != runs.second) neighbourhood[used++] = runs;
-        }
+    grid.forEachNeighbour(c, [&](const CellRuns& runs) { neighbourhood[used++] = runs; });
     std::size_t last = first;
     while (last < m && cells[last].first == c) ++last;
-    // Every point of the cell is tested once against every other observation
-    // with points in the neighbourhood (a match ends the test early).
-    ++s.cell_stamp;
-    std::uint64_t observations_near = 0;
-    for (int h = 0; h < used; ++h)
-      for (std::uint32_t r = neighbourhood[h].first; r < neighbourhood[h].second; ++r) {
-        const int j = grid.runs()[r].observation;
-        if (j == i || s.nearby[j] == s.cell_stamp) continue;
-        s.nearby[j] = s.cell_stamp;
-        ++observations_near;
-        if (s.tested[j] != i) {
-          s.tested[j] = i;
-          ++s.pairs;
-        }
-      }
-    s.tests += observations_near * (last - first);
+    // Each point is tested once against every other observation near its cell.
+    s.tests += std::uint64_t(grid.observationsNear(grid.table().find(c).ordinal) - 1) * (last - first);
     for (std::size_t k = first; k < last; ++k) {
       const Eigen::Vector3f& p = world.begin(i)[cells[k].second];
       s.nextPoint();
       for (int h = 0; h < used; ++h) {
-        for (std::uint32_t r = neighbourhood[h].first; r < neighbourhood[h].second; ++r) {
+        for (std::uint32_t r = neighbourhood[h].begin; r < neighbourhood[h].end; ++r) {
           const Run& run = grid.runs()[r];
           const int j = run.observation;
           if (j == i || s.seen[j] == s.stamp) continue;  // each j counted once per point
+          if (s.tested[j] != i) {
+            s.tested[j] = i;
+            ++s.pairs;
+          }
           for (std::uint32_t q = run.begin; q < run.end; ++q) {
             if (within(p, grid.points()[q])) {
               s.seen[j] = s.stamp;
