@@ -186,8 +186,21 @@ TEST(LocalMapBuilder, MergedCloudIsInTheReferenceFrameWithItsPose) {
   EXPECT_EQ(map.cloud->size(), total);
   const Eigen::Vector3f origin = map.cloud->sensor_origin_.head<3>();
   EXPECT_TRUE(origin.isApprox(obs[map.frame.reference].pose.translation().cast<float>(), 1e-6f));
-  // The reference's own points are unmoved.
-  EXPECT_NEAR((*map.cloud)[0].x, (*obs[0].cloud)[0].x, map.frame.reference == 0 ? 1e-6 : 100.0);
+  // Members are merged in order: the reference's points are unmoved, the
+  // others moved by their pose in the reference frame.
+  std::size_t offset = 0;
+  for (int i = 0; i < 5; ++i) {
+    const Eigen::Isometry3d pose = map.frame.memberPose(i);
+    if (i == map.frame.reference) {
+      EXPECT_TRUE(pose.isApprox(Eigen::Isometry3d::Identity()));
+    }
+    for (std::size_t k = 0; k < obs[i].cloud->size(); k += 37) {
+      const auto& p = (*obs[i].cloud)[k];
+      const Eigen::Vector3f expected = (pose * Eigen::Vector3d(p.x, p.y, p.z)).cast<float>();
+      EXPECT_LT(((*map.cloud)[offset + k].getVector3fMap() - expected).norm(), 1e-5f) << i << " " << k;
+    }
+    offset += obs[i].cloud->size();
+  }
   builder.setVoxelLeafSize(0.2);
   EXPECT_LT(builder.build(obs, {0, 1, 2, 3, 4}, chain(5)).cloud->size(), total / 2);
   EXPECT_EQ(refinementFromString("lum"), Refinement::Lum);

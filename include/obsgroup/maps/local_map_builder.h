@@ -66,6 +66,8 @@ class LocalMapBuilder {
                                       const Partition& partition, const WeightMatrix& W) const;
 
  private:
+  LocalMap<PointT> buildGroup(const std::vector<Observation<PointT>>& observations, const std::vector<int>& group,
+                              const WeightMatrix& W, const std::vector<Eigen::Isometry3d>& poses) const;
   void refineIcp(const std::vector<Observation<PointT>>& observations, const WeightMatrix& W,
                  LocalMapFrame& frame) const;
   /// False (frame unchanged) when LUM moved a pose further than twice the

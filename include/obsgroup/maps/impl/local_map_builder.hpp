@@ -86,6 +86,14 @@ inline std::vector<std::pair<int, int>> maximumSpanningTree(const LocalMapFrame&
   return order;
 }
 
+template <typename PointT>
+std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& observations) {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(observations.size());
+  for (const auto& o : observations) poses.push_back(o.pose);
+  return poses;
+}
+
 inline Eigen::Vector6f toPose6(const Eigen::Isometry3d& pose) {
   Eigen::Vector6f v;
   const Eigen::Affine3f a(pose.matrix().cast<float>());
@@ -194,10 +202,14 @@ bool LocalMapBuilder<PointT>::refineLum(const std::vector<Observation<PointT>>& 
 template <typename PointT>
 LocalMap<PointT> LocalMapBuilder<PointT>::build(const std::vector<Observation<PointT>>& observations,
                                                 const std::vector<int>& group, const WeightMatrix& W) const {
+  return buildGroup(observations, group, W, detail::posesOf(observations));
+}
+
+template <typename PointT>
+LocalMap<PointT> LocalMapBuilder<PointT>::buildGroup(const std::vector<Observation<PointT>>& observations,
+                                                     const std::vector<int>& group, const WeightMatrix& W,
+                                                     const std::vector<Eigen::Isometry3d>& poses) const {
   if (group.empty()) throw std::invalid_argument("LocalMapBuilder: empty group");
-  std::vector<Eigen::Isometry3d> poses;
-  poses.reserve(observations.size());
-  for (const auto& o : observations) poses.push_back(o.pose);
   LocalMap<PointT> map;
   map.frame = initialFrame(group, W, poses);
   // LUM starts from the ICP tree: PCL's LUM diverged from the raw input poses
@@ -234,9 +246,10 @@ template <typename PointT>
 std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<Observation<PointT>>& observations,
                                                              const Partition& partition, const WeightMatrix& W) const {
   std::vector<LocalMap<PointT>> maps(partition.groups.size());
+  const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (std::size_t g = 0; g < partition.groups.size(); ++g) maps[g] = build(observations, partition.groups[g], W);
+  for (std::size_t g = 0; g < partition.groups.size(); ++g) maps[g] = buildGroup(observations, partition.groups[g], W, poses);
   return maps;
 }
 
