@@ -9,6 +9,7 @@
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace obsgroup {
@@ -64,6 +65,12 @@ class ObservationGrouping {
   }
   int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
   void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
+  /// A flag polled during compute() (see interrupt.h); when it is set,
+  /// compute() stops and throws Interrupted. Not owned.
+  void setInterruptFlag(const InterruptFlag* flag) {
+    overlap_.setInterruptFlag(flag);
+    options_.interrupt = flag;
+  }
 
   // --- graph and partition (sec. II, III) ---
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
@@ -92,6 +99,10 @@ class ObservationGrouping {
   const OverlapResult& getOverlap() const { return overlap_result_; }
   /// Time spent in each stage of the last compute().
   const GroupingTimings& getTimings() const { return timings_; }
+  /// What the user should know about the last compute(), deterministic and
+  /// in order: observations with no point (each forms a group of its own),
+  /// then the partition's eigen-solver fallbacks (Partition::warnings).
+  const std::vector<std::string>& getWarnings() const { return warnings_; }
 
  private:
   std::vector<Observation<PointT>> observations_;
@@ -101,6 +112,7 @@ class ObservationGrouping {
   OverlapResult overlap_result_;
   WeightMatrix W_;
   GroupingTimings timings_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace obsgroup

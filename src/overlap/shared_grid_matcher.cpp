@@ -271,7 +271,7 @@ void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDist
 }  // namespace
 
 MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads,
-                                   const ProgressCallback& progress) {
+                                   const ProgressCallback& progress, const InterruptFlag* interrupt) {
   if (!(delta > 0.0) || !std::isfinite(delta))
     throw std::invalid_argument("shared grid: the match distance delta must be finite and > 0");
   const int n = world.size();
@@ -290,6 +290,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
     RowScratch scratch(n);
 #pragma omp for schedule(dynamic, 8)
     for (int i = 0; i < n; ++i) {
+      if (interruptRequested(interrupt)) continue;  // no throwing inside the parallel region
       countRow(grid, world, i, within, scratch, out.rows[i]);
       const std::size_t now = ++done;
       if (progress && omp_get_thread_num() == 0) progress(now, n);
@@ -297,6 +298,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
     pairs += scratch.pairs;
     tests += scratch.tests;
   }
+  throwIfInterrupted(interrupt);
   if (progress) progress(n, n);
   out.pairs_evaluated = pairs;
   out.point_tests = tests;

@@ -1,6 +1,7 @@
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <omp.h>
 #include <stdexcept>
 
@@ -23,6 +24,7 @@ std::string toString(SplitNode::Outcome outcome) {
     case SplitNode::Outcome::NoSplit: return "no_split";
     case SplitNode::Outcome::MaxDepth: return "max_depth";
     case SplitNode::Outcome::TooFewNodes: return "too_few_nodes";
+    case SplitNode::Outcome::EigenSolverFailed: return "eigen_solver_failed";
   }
   return "?";
 }
@@ -35,6 +37,7 @@ struct Decision {
   SplitNode node;  // members, parent and depth unchanged; the rest decided
   std::vector<std::vector<int>> children;
   int child_depth = 0;
+  std::string warning;  // empty, or what the user should know about this node
 };
 
 class Partitioner {
@@ -57,6 +60,7 @@ class Partitioner {
     // recursions cannot overflow the stack.
     const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
     while (!frontier.empty()) {
+      throwIfInterrupted(options_.interrupt);
       std::vector<Decision> decisions(frontier.size());
       std::vector<std::string> errors(frontier.size());
 #pragma omp parallel num_threads(threads)
@@ -77,6 +81,7 @@ class Partitioner {
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];
         Decision& d = decisions[k];
+        if (!d.warning.empty()) out_.warnings.push_back(std::move(d.warning));
         d.node.members = std::move(out_.splits[id].members);
         d.node.parent = out_.splits[id].parent;
         d.node.depth = out_.splits[id].depth;
@@ -126,8 +131,22 @@ class Partitioner {
       return d;
     }
 
-    Bisection b = spectralBisection(sub, options_.split, options_.eigen, min_size);
+    Bisection b;
+    try {
+      b = spectralBisection(sub, options_.split, options_.eigen, min_size);
+    } catch (const EigenSolverError& e) {
+      // A group left whole is a usable, if coarse, answer; an unchecked
+      // eigenvector is not.
+      d.node.outcome = SplitNode::Outcome::EigenSolverFailed;
+      d.warning = std::string(e.what()) + "; a group of " + std::to_string(members.size()) +
+                  " observations (first " + std::to_string(members.front()) + ") was kept whole";
+      return d;
+    }
     d.node.attempted = true;
+    d.node.solver_fell_back = b.fiedler.fell_back;
+    if (b.fiedler.fell_back)
+      d.warning = "Lanczos did not converge on a group of " + std::to_string(members.size()) +
+                  " observations (first " + std::to_string(members.front()) + "); the dense solver was used";
     d.node.ncut = b.cut.ncut;
     d.node.threshold = b.threshold;
     d.node.eigenvalue = b.fiedler.eigenvalue;
@@ -170,12 +189,34 @@ class Partitioner {
   Partition out_;
 };
 
+/// Weights are overlaps: finite, non-negative and symmetric. Anything else
+/// would make Ncut meaningless, so it is refused rather than partitioned.
+void checkWeights(const WeightMatrix& W) {
+  const WeightMatrix T = W.transpose();  // O(nnz); compared in lock step with W
+  for (Eigen::Index c = 0; c < W.outerSize(); ++c) {
+    WeightMatrix::InnerIterator it(W, c), mirror(T, c);
+    for (; it; ++it, ++mirror) {
+      const double w = it.value();
+      if (!std::isfinite(w) || w < 0.0)
+        throw std::invalid_argument("recursivePartition: W(" + std::to_string(it.row()) + ", " +
+                                    std::to_string(it.col()) + ") = " + std::to_string(w) +
+                                    " is not a finite, non-negative weight");
+      if (!mirror || mirror.row() != it.row() || std::abs(w - mirror.value()) > 1e-9 * std::max(1.0, w))
+        throw std::invalid_argument("recursivePartition: W is not symmetric near (" +
+                                    std::to_string(it.row()) + ", " + std::to_string(it.col()) + ")");
+    }
+    if (mirror)
+      throw std::invalid_argument("recursivePartition: W is not symmetric in column " + std::to_string(c));
+  }
+}
+
 }  // namespace
 
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options) {
   if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
+  checkWeights(W);
   return Partitioner(W, options).run();
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -36,7 +37,7 @@ class DeflatedLaplacianInverse {
       : n_(L.rows()), z0_(std::move(z0)) {
     ldlt_.compute(WeightMatrix(L.topLeftCorner(n_ - 1, n_ - 1)));
     if (ldlt_.info() != Eigen::Success)
-      throw std::runtime_error("Fiedler vector: the grounded Laplacian could not be factorised");
+      throw EigenSolverError("Fiedler vector: the grounded Laplacian could not be factorised");
   }
   Eigen::Index rows() const { return n_; }
   Eigen::Index cols() const { return n_; }
@@ -86,11 +87,28 @@ class DeflatedNormalizedAdjacency {
 constexpr double kDenseGraphShare = 0.125;
 constexpr double kDenseGraphDegree = 48.0;
 
+/// ||L z - (z'Lz) z|| for a unit z.
+double residual(const WeightMatrix& L, const Eigen::VectorXd& z_in) {
+  const Eigen::VectorXd z = z_in.normalized();
+  const Eigen::VectorXd Lz = L * z;
+  return (Lz - z.dot(Lz) * z).norm();
+}
+
+/// A computed eigenvector is accepted when its residual is below this. The
+/// eigenvalues of L lie in [0, 2], and the Lanczos tolerance (1e-10) leaves
+/// residuals around 1e-9 and below on the graphs of the test suite.
+constexpr double kMaxResidual = 1e-6;
+
 template <typename Operator>
 bool solveSparse(const WeightMatrix& L, const Eigen::VectorXd& z0, const FiedlerOptions& options,
                  int ncv, Eigen::VectorXd& z) {
-  Operator op(L, z0);
-  Spectra::SymEigsSolver<Operator> solver(op, 1, ncv);
+  std::optional<Operator> op;
+  try {
+    op.emplace(L, z0);
+  } catch (const EigenSolverError&) {
+    return false;  // e.g. a factorisation that failed: the next solver takes over
+  }
+  Spectra::SymEigsSolver<Operator> solver(*op, 1, ncv);
   // A fixed start vector, orthogonal to z0, keeps the result deterministic.
   Eigen::VectorXd start = Eigen::VectorXd::LinSpaced(L.rows(), 1.0, 2.0);
   start -= z0 * z0.dot(start);
@@ -98,13 +116,16 @@ bool solveSparse(const WeightMatrix& L, const Eigen::VectorXd& z0, const Fiedler
   solver.compute(Spectra::SortRule::LargestAlge, options.max_iterations, options.tolerance);
   if (solver.info() != Spectra::CompInfo::Successful) return false;
   z = solver.eigenvectors().col(0);
-  return true;
+  // Spectra's own test is on the operator; the result must also be an
+  // eigenvector of L itself, orthogonal to the trivial one.
+  return z.allFinite() && z.norm() > 0.5 && residual(L, z) <= kMaxResidual &&
+         std::abs(z.dot(z0)) <= kMaxResidual * z.norm();
 }
 
 Eigen::VectorXd solveDense(const WeightMatrix& L) {
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(Eigen::MatrixXd(L), Eigen::ComputeEigenvectors);
   if (solver.info() != Eigen::Success)
-    throw std::runtime_error("Fiedler vector: the dense eigen solver did not converge");
+    throw EigenSolverError("Fiedler vector: the dense eigen solver did not converge");
   return solver.eigenvectors().col(1);  // eigenvalues ascend: column 1 is the second smallest
 }
 
@@ -147,13 +168,17 @@ FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options
     result.fell_back = !result.sparse;
   }
   if (!result.sparse) {
-    constexpr Eigen::Index kDenseFallbackLimit = 5000;
-    if (result.fell_back && n > kDenseFallbackLimit)
-      throw std::runtime_error("Fiedler vector: Lanczos did not converge on a graph of " +
-                               std::to_string(n) + " nodes, too large for the dense solver");
+    if (result.fell_back && n > options.dense_fallback_max_size)
+      throw EigenSolverError("Fiedler vector: Lanczos did not converge on a graph of " + std::to_string(n) +
+                             " nodes, above the dense fallback limit of " +
+                             std::to_string(options.dense_fallback_max_size));
     z = solveDense(L);
   }
   z.normalize();
+  result.residual = residual(L, z);
+  if (!(result.residual <= kMaxResidual))
+    throw EigenSolverError("Fiedler vector: the eigenvector found has residual " + std::to_string(result.residual) +
+                           " on a graph of " + std::to_string(n) + " nodes");
   result.eigenvalue = z.dot(L * z);  // Rayleigh quotient of eq. (8), exact for an eigenvector
   result.y = inv_sqrt_d.cwiseProduct(z);  // y = D^-1/2 z, eq. (11)
   fixSign(result.y);

@@ -24,6 +24,7 @@ void ObservationGrouping<PointT>::clear() {
   observations_.clear();
   overlap_result_ = OverlapResult{};
   W_ = WeightMatrix{};
+  warnings_.clear();
 }
 
 template <typename PointT>
@@ -41,6 +42,14 @@ Partition ObservationGrouping<PointT>::compute() {
   start = Clock::now();
   Partition partition = recursivePartition(W_, options_);
   timings_.partition_s = seconds_since(start);
+
+  warnings_.clear();
+  const auto& points = overlap_result_.points_per_observation;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i] == 0)
+      warnings_.push_back("observation " + std::to_string(i) +
+                          " has no finite point: it overlaps nothing and forms a group of its own");
+  warnings_.insert(warnings_.end(), partition.warnings.begin(), partition.warnings.end());
   return partition;
 }
 

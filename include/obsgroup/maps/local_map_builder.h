@@ -4,6 +4,7 @@
 /// step 3): the group's observations relative to a reference observation,
 /// optionally refined by scan alignment, merged into one cloud.
 
+#include "obsgroup/interrupt.h"
 #include "obsgroup/maps/topological_map.h"
 #include "obsgroup/observation.h"
 
@@ -56,6 +57,9 @@ class LocalMapBuilder {
   /// Threads over groups; the result does not depend on it.
   void setNumberOfThreads(int threads) { threads_ = threads; }
   int getNumberOfThreads() const { return threads_; }
+  /// A flag polled between groups; when set, build() throws Interrupted.
+  void setInterruptFlag(const InterruptFlag* flag) { interrupt_ = flag; }
+  const InterruptFlag* getInterruptFlag() const { return interrupt_; }
 
   /// The local map of one group (observation indices, ascending); W chooses
   /// the reference and the pairs to align.
@@ -80,6 +84,7 @@ class LocalMapBuilder {
   double max_correspondence_distance_ = 0.25;
   int max_iterations_ = 30;
   int threads_ = 0;
+  const InterruptFlag* interrupt_ = nullptr;
 };
 
 }  // namespace obsgroup

@@ -3,6 +3,7 @@
 /// Sensed-space overlap (SSO) of paper sec. IV-A, eq. (16)-(18), for any PCL
 /// point type with x, y, z.
 
+#include "obsgroup/interrupt.h"
 #include "obsgroup/observation.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 #include "obsgroup/overlap/world_points.h"
@@ -67,6 +68,11 @@ class SensedSpaceOverlap {
   /// on big logs); empty by default.
   void setProgressCallback(ProgressCallback callback) { progress_ = std::move(callback); }
 
+  /// A flag polled during compute(); when it is set, compute() stops and
+  /// throws Interrupted. Not owned; null (the default) disables polling.
+  void setInterruptFlag(const InterruptFlag* flag) { interrupt_ = flag; }
+  const InterruptFlag* getInterruptFlag() const { return interrupt_; }
+
   /// Filters and moves every observation to the common frame. Throws
   /// std::invalid_argument on a null cloud, a non-finite pose or a voxel
   /// leaf too small for a cloud's extent.
@@ -86,6 +92,7 @@ class SensedSpaceOverlap {
   SearchMethodPtr search_;
   int threads_ = 0;
   ProgressCallback progress_;
+  const InterruptFlag* interrupt_ = nullptr;
 };
 
 }  // namespace obsgroup

@@ -4,6 +4,7 @@
 /// observation's world points, so the whole overlap matrix comes from a
 /// single pass over the points.
 
+#include "obsgroup/interrupt.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 
 namespace obsgroup {
@@ -17,7 +18,9 @@ namespace obsgroup {
 /// point is tested against the 3x3 (flat data) or 3x3x3 neighbouring cells,
 /// and each nearby observation is counted at most once per point. Rows are
 /// independent, so the result is the same for any number of threads.
+/// Throws Interrupted when `interrupt` is set during the pass.
 MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0,
-                                   const ProgressCallback& progress = {});
+                                   const ProgressCallback& progress = {},
+                                   const InterruptFlag* interrupt = nullptr);
 
 }  // namespace obsgroup

@@ -4,6 +4,7 @@
 /// minimum normalized cut stays below a threshold.
 
 #include "obsgroup/graph/observation_graph.h"
+#include "obsgroup/interrupt.h"
 #include "obsgroup/spectral/spectral_bisection.h"
 
 #include <limits>
@@ -27,6 +28,9 @@ struct PartitionOptions {
   /// default). The result is the same for any value.
   int threads = 0;
   FiedlerOptions eigen;
+  /// Polled between the levels of the split tree; when set, recursivePartition
+  /// throws Interrupted.
+  const InterruptFlag* interrupt = nullptr;
 };
 
 /// One node of the split tree.
@@ -43,7 +47,8 @@ struct SplitNode {
     GroupTooSmall,     ///< Bisection computed, a side below min_group_size.
     NoSplit,           ///< Bisection computed, all nodes on one side.
     MaxDepth,          ///< Not attempted: max_depth reached.
-    TooFewNodes        ///< Not attempted: a single node, or fewer than 2 * min_group_size.
+    TooFewNodes,       ///< Not attempted: a single node, or fewer than 2 * min_group_size.
+    EigenSolverFailed  ///< No eigen solver converged: kept whole, with a warning.
   };
   std::vector<int> members;   ///< Observation indices, ascending.
   Kind kind = Kind::Leaf;
@@ -54,6 +59,7 @@ struct SplitNode {
   double threshold = 0.0;     ///< Eigenvector threshold of the bisection.
   double eigenvalue = std::numeric_limits<double>::quiet_NaN();
   bool sparse_solver = false;
+  bool solver_fell_back = false;  ///< Lanczos failed; the dense solver gave the eigenvector.
   Eigen::VectorXd eigenvector;  ///< y over `members` (empty unless kept).
   int depth = 0;              ///< Number of accepted bisections above this node.
   int parent = -1;
@@ -71,9 +77,14 @@ struct Partition {
   std::vector<int> group_of;
   /// The split tree in breadth-first order; splits[0] is the root.
   std::vector<SplitNode> splits;
+  /// Things the user should know, in split-tree order: an eigen solve that
+  /// fell back to the dense solver, or failed and left a node whole.
+  std::vector<std::string> warnings;
 };
 
 /// Partitions the graph W (with its diagonal as configured) recursively.
+/// Throws std::invalid_argument when W is not square, symmetric, finite and
+/// non-negative, and Interrupted when options.interrupt is set.
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options = {});
 
 }  // namespace obsgroup

@@ -249,7 +249,9 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
   const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (std::size_t g = 0; g < partition.groups.size(); ++g) maps[g] = buildGroup(observations, partition.groups[g], W, poses);
+  for (std::size_t g = 0; g < partition.groups.size(); ++g)
+    if (!interruptRequested(interrupt_)) maps[g] = buildGroup(observations, partition.groups[g], W, poses);
+  throwIfInterrupted(interrupt_);
   return maps;
 }
 

@@ -155,6 +155,7 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
     SearchMethodPtr search = search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false));
 #pragma omp for schedule(dynamic, 4)
     for (int j = 0; j < n; ++j) {
+      if (interruptRequested(interrupt_)) continue;  // no throwing inside the parallel region
       if (!candidates[j].empty())
         columns[j] = detail::countColumnPclSearch(*search, world, j, candidates[j], delta_, tests);
       pairs += candidates[j].size();
@@ -162,6 +163,7 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
       if (progress_ && omp_get_thread_num() == 0) progress_(now, n);
     }
   }
+  throwIfInterrupted(interrupt_);
   if (progress_) progress_(n, n);
 
   MatchCounts out;
@@ -179,7 +181,7 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
     throw std::invalid_argument("match distance delta must be finite and > 0");
   const WorldPoints world = toWorld(observations);
   const MatchCounts counts = neighbour_search_ == NeighbourSearch::SharedGrid
-                                 ? countMatchesSharedGrid(world, delta_, threads_, progress_)
+                                 ? countMatchesSharedGrid(world, delta_, threads_, progress_, interrupt_)
                                  : countMatchesPclSearch(world);
   return assembleOverlap(counts, world);
 }
