@@ -19,6 +19,10 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <chrono>
+#include <csignal>
+#include <iomanip>
+#include <iterator>
 
 namespace fs = std::filesystem;
 
@@ -312,6 +316,30 @@ TEST_F(Cli, NanAndInfReadingsAreNoReturn) {
             readJson(dir_ / "c" / "partition.json").at("statistics").at("points").get<int>());
 }
 
+TEST_F(Cli, ScanWithoutReturnIsAGroupOfItsOwnWithAWarning) {
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string log, line;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (k == 1) {  // the second scan: every reading "no return" (nan, or at the maximum range)
+      std::istringstream split(line);
+      std::vector<std::string> f{std::istream_iterator<std::string>(split), {}};
+      const int n = std::stoi(f[8]);
+      for (int r = 0; r < n; ++r) f[9 + r] = r % 2 ? "nan" : f[5];
+      line.clear();
+      for (const auto& field : f) line += field + " ";
+    }
+    log += line + "\n";
+  }
+  writeFile(dir_ / "blind.clf", log);
+  const Result r = run("partition " + (dir_ / "blind.clf").string() + " --no-pictures -o " + (dir_ / "o").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("blind.clf:2: the scan has no return"), std::string::npos) << r.err;
+  const auto partition = readJson(dir_ / "o" / "partition.json");
+  EXPECT_NE(std::find(partition.at("groups").begin(), partition.at("groups").end(), nlohmann::json({1})),
+            partition.at("groups").end());
+  EXPECT_EQ(partition.at("warnings").size(), 1u);
+}
+
 TEST_F(Cli, BadCarmenLogs) {
   struct Case {
     std::string name, content, expected;
@@ -396,8 +424,14 @@ TEST_F(Cli, BadPcdSequences) {
   pcl::io::savePCDFileASCII((seq / "000002.pcd").string(), empty);
   r = run("partition " + seq.string() + " --no-pictures -o " + (dir_ / "o4").string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("000002.pcd: no point"), std::string::npos) << r.err;
-  EXPECT_EQ(readJson(dir_ / "o4" / "partition.json").at("observations"), 3);
+  EXPECT_NE(r.err.find("000002.pcd: the cloud has no point; kept as an observation (a group of its own)"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("000002.pcd"), r.err.rfind("000002.pcd")) << "warned twice:\n" << r.err;
+  const auto partition = readJson(dir_ / "o4" / "partition.json");
+  EXPECT_EQ(partition.at("observations"), 3);
+  EXPECT_EQ(partition.at("warnings").size(), 1u);
+  EXPECT_NE(std::find(partition.at("groups").begin(), partition.at("groups").end(), nlohmann::json({2})),
+            partition.at("groups").end());
 }
 
 TEST_F(Cli, BadPoseFiles) {
@@ -514,4 +548,173 @@ TEST_F(Cli, ShippedDatasetsAreWhatTheSimulatorWrites) {
   EXPECT_EQ(readFile(dir_ / "office_2d" / "office.clf"), readFile(kData + "/office_2d/office.clf"));
   EXPECT_EQ(readFile(dir_ / "office_3d" / "poses.txt"), readFile(kData + "/office_3d/poses.txt"));
   EXPECT_EQ(readFile(dir_ / "office_3d" / "pcd" / "000017.pcd"), readFile(kData + "/office_3d/pcd/000017.pcd"));
+}
+
+namespace {
+
+/// Every file under `folder`, by relative path, with its content.
+std::map<std::string, std::string> snapshot(const fs::path& folder) {
+  std::map<std::string, std::string> files;
+  if (!fs::exists(folder)) return files;
+  for (const auto& entry : fs::recursive_directory_iterator(folder))
+    if (entry.is_regular_file()) files[fs::relative(entry.path(), folder).string()] = readFile(entry.path());
+  return files;
+}
+
+/// Runs the command with SIGINT sent after `delay`; returns its exit code,
+/// or -SIGINT when the signal came before the command installed its handler.
+int runInterruptedAfter(const std::vector<std::string>& args, std::chrono::milliseconds delay) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(OBSGROUP_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    std::freopen("/dev/null", "w", stdout);
+    std::freopen("/dev/null", "w", stderr);
+    ::execv(OBSGROUP_EXE, argv.data());
+    std::_Exit(127);
+  }
+  int status = 0;
+  const auto deadline = std::chrono::steady_clock::now() + delay;
+  while (std::chrono::steady_clock::now() < deadline)
+    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  ::kill(pid, SIGINT);
+  ::waitpid(pid, &status, 0);
+  if (WIFSIGNALED(status)) return -WTERMSIG(status);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/// The log with every laser and robot pose moved by (dx, dy): ROBOTLASER1
+/// lines, whose pose fields follow the ranges and the remissions.
+std::string shiftedRobotLaserLog(const std::string& log, double dx, double dy) {
+  std::istringstream in(log);
+  std::ostringstream out;
+  out.precision(17);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("ROBOTLASER1 ", 0) != 0) {
+      out << line << "\n";
+      continue;
+    }
+    std::istringstream words(line);
+    std::vector<std::string> f{std::istream_iterator<std::string>(words), {}};
+    const std::size_t n = std::stoul(f[8]), tail = 10 + n + std::stoul(f[9 + n]);
+    for (std::size_t k : {tail, tail + 3}) {
+      f[k] = (std::ostringstream() << std::setprecision(17) << std::stod(f[k]) + dx).str();
+      f[k + 1] = (std::ostringstream() << std::setprecision(17) << std::stod(f[k + 1]) + dy).str();
+    }
+    for (std::size_t k = 0; k < f.size(); ++k) out << (k ? " " : "") << f[k];
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
+  const std::string input = kData + "/real/localization_demo/localization_demo.clf";
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("partition " + input + " -q -o " + out.string()).code, 0);
+  const auto old_results = snapshot(out);
+  ASSERT_GT(old_results.size(), 8u);
+  // Ctrl-C at every stage of a rerun with other parameters: reading, overlap,
+  // partition, local maps, pictures, the swap. Each outcome is whole.
+  bool saw_interrupted = false, saw_completed = false;
+  for (int ms = 0; ms <= 1500 && !saw_completed; ms += 30) {
+    const int code = runInterruptedAfter(
+        {"partition", input, "--delta", "0.2", "--force", "--threads", "1", "-o", out.string()},
+        std::chrono::milliseconds(ms));
+    ASSERT_TRUE(code == 130 || code == 0 || code == -SIGINT) << "exit code " << code << " at " << ms << " ms";
+    const auto now = snapshot(out);
+    if (code != 0) {
+      saw_interrupted = saw_interrupted || code == 130;
+      EXPECT_EQ(now, old_results) << "interrupted at " << ms << " ms left a changed folder";
+    } else {
+      saw_completed = true;
+      const auto partition = nlohmann::json::parse(now.at("partition.json"));
+      EXPECT_EQ(partition.at("parameters").at("delta"), 0.2);
+      std::size_t maps = 0;
+      for (const auto& [name, content] : now) maps += name.rfind("local_maps/group_", 0) == 0;
+      EXPECT_EQ(maps, partition.at("groups").size());
+    }
+    // Nothing but the results and the test's own files beside them.
+    for (const auto& entry : fs::directory_iterator(dir_))
+      EXPECT_TRUE(entry.path().filename() == "out" || entry.path().filename() == "stderr.txt") << entry.path();
+  }
+  EXPECT_TRUE(saw_interrupted);
+  EXPECT_TRUE(saw_completed);
+}
+
+TEST_F(Cli, FoldersHoldingOtherFilesAreNeverReplaced) {
+  const std::string input = kData + "/office_2d/office.clf";
+  writeFile(dir_ / "mine" / "notes.txt", "my notes");
+  const Result refused = run("partition " + input + " -q --force -o " + (dir_ / "mine").string());
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("notes.txt"), std::string::npos) << refused.err;
+  EXPECT_EQ(snapshot(dir_ / "mine").size(), 1u);
+  EXPECT_EQ(readFile(dir_ / "mine" / "notes.txt"), "my notes");
+  // A staging folder of a killed run (no such process) is cleaned up by the next run.
+  fs::create_directories(dir_ / ".out.obsgroup-staging-999999999" / "local_maps");
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "out").string()).code, 0);
+  EXPECT_FALSE(fs::exists(dir_ / ".out.obsgroup-staging-999999999"));
+}
+
+TEST_F(Cli, PosesAtUtmCoordinatesAreWrittenAtFullPrecision) {
+  // Half a million metres east, five million north: float keeps ~0.5 m
+  // there and a PCD VIEWPOINT 6 digits (~5 m).
+  const double dx = 512345.678901, dy = 5123456.789012;
+  const std::string log = readFile(kData + "/real/localization_demo/localization_demo.clf");
+  writeFile(dir_ / "utm.clf", shiftedRobotLaserLog(log, dx, dy));
+  ASSERT_EQ(run("partition " + kData + "/real/localization_demo/localization_demo.clf -q --no-pictures -o " +
+                (dir_ / "here").string()).code, 0);
+  ASSERT_EQ(run("partition " + (dir_ / "utm.clf").string() + " -q --no-pictures -o " + (dir_ / "utm").string()).code, 0);
+
+  // The same groups and arcs: the overlap is computed re-centred.
+  const auto here = readJson(dir_ / "here" / "partition.json"), utm = readJson(dir_ / "utm" / "partition.json");
+  EXPECT_EQ(here.at("groups"), utm.at("groups"));
+  const auto here_topology = readJson(dir_ / "here" / "topology.json");
+  const auto utm_topology = readJson(dir_ / "utm" / "topology.json");
+  ASSERT_EQ(here_topology.at("nodes").size(), utm_topology.at("nodes").size());
+  ASSERT_EQ(here_topology.at("arcs").size(), utm_topology.at("arcs").size());
+  for (std::size_t a = 0; a < here_topology.at("arcs").size(); ++a)
+    for (const char* key : {"x", "y"})
+      EXPECT_NEAR(here_topology["arcs"][a]["transform"][key].get<double>(),
+                  utm_topology["arcs"][a]["transform"][key].get<double>(), 1e-6);
+
+  // Read back: topology.json and local_maps/poses.txt hold every reference
+  // pose to well under a millimetre; the VIEWPOINT of the PCD does not.
+  std::istringstream poses(readFile(dir_ / "utm" / "local_maps" / "poses.txt"));
+  std::string line;
+  std::size_t k = 0;
+  while (std::getline(poses, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double group = 0, x = 0, y = 0;
+    fields >> group >> x >> y;
+    ASSERT_EQ(group, double(k));
+    const auto& expected = here_topology["nodes"][k]["pose"];
+    EXPECT_NEAR(x, expected["x"].get<double>() + dx, 1e-6) << line;
+    EXPECT_NEAR(y, expected["y"].get<double>() + dy, 1e-6) << line;
+    EXPECT_NEAR(utm_topology["nodes"][k]["pose"]["x"].get<double>(), expected["x"].get<double>() + dx, 1e-6);
+    EXPECT_NEAR(utm_topology["nodes"][k]["pose"]["y"].get<double>(), expected["y"].get<double>() + dy, 1e-6);
+    ++k;
+  }
+  EXPECT_EQ(k, here_topology.at("nodes").size());
+  pcl::PCLPointCloud2 blob;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  ASSERT_EQ(pcl::io::loadPCDFile((dir_ / "utm" / "local_maps" / "group_000.pcd").string(), blob, origin, orientation), 0);
+  EXPECT_GT(std::abs(origin.y() - (here_topology["nodes"][0]["pose"]["y"].get<double>() + dy)), 1e-3)
+      << "PCD VIEWPOINTs have become exact: local_maps/poses.txt may no longer be needed";
+}
+
+TEST_F(Cli, RunsAreByteIdenticalApartFromTimings) {
+  const std::string input = kData + "/office_2d/office.clf";
+  ASSERT_EQ(run("partition " + input + " -q -o " + (dir_ / "a").string()).code, 0);
+  ASSERT_EQ(run("partition " + input + " -q -o " + (dir_ / "b").string()).code, 0);
+  auto a = snapshot(dir_ / "a"), b = snapshot(dir_ / "b");
+  const auto strip = [](std::string text) { return text.substr(0, text.find("\"timing_s\"")); };
+  a["partition.json"] = strip(a["partition.json"]);
+  b["partition.json"] = strip(b["partition.json"]);
+  EXPECT_EQ(a, b);  // every file: JSON, DOT, PCD, PNG and SVG
 }

@@ -1,7 +1,8 @@
 // obsgroup: group robot observations into consistent local maps and a
 // metric-topological map (Blanco, Gonzalez, Fernandez-Madrigal, ICRA 2006).
 //
-// Exit codes: 0 done, 2 usage error, 3 input error, 1 anything else.
+// Exit codes: 0 done, 2 usage error, 3 input error, 130 interrupted (SIGINT
+// or SIGTERM: the output folder is left as it was), 1 anything else.
 
 #include "errors.h"
 #include "partition_command.h"
@@ -9,10 +10,28 @@
 #include <CLI/CLI.hpp>
 #include <pcl/console/print.h>
 
+#include <signal.h>
+
 #include <cstdio>
 #include <map>
 
 namespace {
+
+obsgroup::InterruptFlag interrupt_requested{false};
+static_assert(obsgroup::InterruptFlag::is_always_lock_free, "a signal handler may only touch lock-free atomics");
+
+extern "C" void onInterrupt(int) { interrupt_requested.store(true); }
+
+/// The first Ctrl-C asks the run to stop cleanly (it polls the flag); the
+/// handler is then reset, so a second one ends the process at once.
+void catchInterrupts() {
+  struct sigaction action {};
+  action.sa_handler = onInterrupt;
+  action.sa_flags = SA_RESETHAND;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
 
 void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, double& fov, double& max_range,
                          std::string& poses, int& max_depth, double& map_voxel) {
@@ -112,8 +131,13 @@ int main(int argc, char** argv) {
   if (partition->count("--max-depth")) args.max_depth = max_depth;
   if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
 
+  args.interrupt = &interrupt_requested;
+  catchInterrupts();
   try {
     return obsgroup::cli::runPartition(args);
+  } catch (const obsgroup::Interrupted&) {
+    std::fprintf(stderr, "\nobsgroup: interrupted; %s was left as it was\n", args.output.c_str());
+    return 130;
   } catch (const obsgroup::io::UsageError& e) {
     std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
     return 2;

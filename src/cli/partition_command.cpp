@@ -55,17 +55,29 @@ void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
 }
 
-void warn(const PartitionArgs& args, const std::string& message) {
-  if (!args.quiet) std::fprintf(stderr, "obsgroup: warning: %s\n", message.c_str());
-}
+/// Warnings go to stderr as they happen and into partition.json.
+class Warnings {
+ public:
+  explicit Warnings(bool quiet) : quiet_(quiet) {}
+  void operator()(const std::string& message) {
+    if (!quiet_) std::fprintf(stderr, "obsgroup: warning: %s\n", message.c_str());
+    all_.push_back(message);
+  }
+  const std::vector<std::string>& all() const { return all_; }
+
+ private:
+  bool quiet_;
+  std::vector<std::string> all_;
+};
 
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
-  for (const auto& w : input.warnings) warn(args, w);
-  for (std::size_t i = 0; i < observations.size(); ++i)
-    if (observations[i].cloud->empty()) warn(args, input.labels[i] + ": no point; kept as a group of its own");
+  Warnings warn(args.quiet);
+  for (const auto& w : input.warnings) warn(w);
 
+  throwIfInterrupted(args.interrupt);
   ObservationGrouping<PointT> grouping;
+  grouping.setInterruptFlag(args.interrupt);
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   grouping.setMatchDistance(args.delta);
   grouping.setVoxelLeafSize(args.voxel);
@@ -83,6 +95,13 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
     throw io::InputError(args.input + ": " + e.what());
   }
   bar.finish();
+  // The core's warnings name observation indices; the user knows lines and
+  // files. The readers already warned about empty clouds.
+  const auto& points_per_observation = grouping.getOverlap().points_per_observation;
+  for (std::size_t i = 0; i < points_per_observation.size(); ++i)
+    if (points_per_observation[i] == 0 && !observations[i].cloud->empty())
+      warn(input.labels[i] + ": only NaN/Inf points; kept as a group of its own");
+  for (const auto& w : partition.warnings) warn(w);
 
   const auto maps_start = Clock::now();
   LocalMapBuilder<PointT> builder;
@@ -90,13 +109,14 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   const double map_voxel = args.map_voxel.value_or(args.delta / 2);
   builder.setVoxelLeafSize(map_voxel);
   builder.setNumberOfThreads(args.threads);
+  builder.setInterruptFlag(args.interrupt);
   const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
   std::vector<LocalMapFrame> frames;
   for (std::size_t g = 0; g < maps.size(); ++g) {
     frames.push_back(maps[g].frame);
-    if (!maps[g].filtered) warn(args, "local map " + std::to_string(g) + ": too large for a " +
+    if (!maps[g].filtered) warn("local map " + std::to_string(g) + ": too large for a " +
                                           std::to_string(map_voxel) + " m voxel filter; written unfiltered");
-    if (maps[g].fell_back) warn(args, "local map " + std::to_string(g) + ": LUM diverged; kept the ICP alignment");
+    if (maps[g].fell_back) warn("local map " + std::to_string(g) + ": LUM diverged; kept the ICP alignment");
   }
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& o : observations) poses.push_back(o.pose);
@@ -104,10 +124,11 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   const double maps_s = secondsSince(maps_start);
 
   const auto outputs_start = Clock::now();
-  const io::OutputFolder out(args.output, args.force);
+  io::OutputFolder out(args.output, args.force, args.interrupt);
   const std::size_t map_points = io::writeLocalMaps(out, maps);
   out.writeText("topology.json", io::topologyJson(topology));
   out.writeText("topology.dot", io::topologyDot(topology));
+  out.writeText("local_maps/poses.txt", io::localMapPosesTum(topology));
   if (args.pictures) {
     SensedSpaceOverlap<PointT> world_frame;
     world_frame.setVoxelLeafSize(args.voxel);
@@ -142,11 +163,12 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
                     {"groups", partition.groups.size()},
                     {"local_map_points", map_points}};
   const auto& t = grouping.getTimings();
+  run.warnings = warn.all();
   run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s}, {"graph", t.graph_s},
                   {"partition", t.partition_s}, {"local_maps", maps_s},   {"outputs", outputs_s},
                   {"threads", args.threads}};
-  // partition.json last: its presence marks a complete run.
   out.writeText("partition.json", io::partitionJson(partition, run));
+  out.commit();
 
   if (!args.quiet) {
     std::fprintf(stderr,

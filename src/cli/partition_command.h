@@ -38,10 +38,13 @@ struct PartitionArgs {
   bool force = false;
   bool quiet = false;
   bool pictures = true;
+  /// Set (by a SIGINT/SIGTERM handler) to stop the run; the output folder is
+  /// then left as it was.
+  const InterruptFlag* interrupt = nullptr;
 };
 
-/// Runs the command; returns the exit code. Throws io::UsageError (exit 2)
-/// and io::InputError (exit 3).
+/// Runs the command; returns the exit code. Throws io::UsageError (exit 2),
+/// io::InputError (exit 3) and Interrupted.
 int runPartition(const PartitionArgs& args);
 
 }  // namespace obsgroup::cli

@@ -174,6 +174,15 @@ void applyGeometry(LaserScan& scan, LaserSource source, const LaserParams& param
   scan.max_range = params.get("robot_" + side + "_laser_max").value_or(kDefaultMaxRange);
 }
 
+/// A reading that gives a point (see scanToCloud).
+bool isReturn(double r, double max_range) { return std::isfinite(r) && r > 0.0 && r < max_range; }
+
+bool hasReturn(const LaserScan& scan) {
+  for (double r : scan.ranges)
+    if (isReturn(r, scan.max_range)) return true;
+  return false;
+}
+
 }  // namespace
 
 CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
@@ -238,6 +247,9 @@ CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
   for (LaserScan& scan : log.scans) {
     if (log.source != LaserSource::RobotLaser) applyGeometry(scan, log.source, params, options);
     if (options.max_range) scan.max_range = *options.max_range;
+    if (!hasReturn(scan))
+      log.warnings.push_back(path + ":" + std::to_string(scan.line) +
+                             ": the scan has no return; kept as an observation (a group of its own)");
   }
   return log;
 }
@@ -247,7 +259,7 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan) {
   cloud->reserve(scan.ranges.size());
   for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
     const double r = scan.ranges[k];
-    if (!std::isfinite(r) || r <= 0.0 || r >= scan.max_range) continue;  // no return
+    if (!isReturn(r, scan.max_range)) continue;
     const double angle = scan.start_angle + k * scan.angle_step;
     cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
   }

@@ -1,7 +1,12 @@
 #pragma once
-// The folder the command writes into: never overwritten without --force, and
-// every file written under a temporary name and renamed into place, so an
-// interrupted run never leaves a half-written file.
+// The folder the command writes into, replaced as a whole: every result is
+// written into a hidden staging folder beside it, and commit() swaps the two
+// at once (renameat2 RENAME_EXCHANGE). A run that fails or is interrupted
+// before commit() leaves the folder exactly as it was: the old results, or
+// none, never a mix. Results are never replaced without --force, and a
+// folder holding files obsgroup did not write is never replaced at all.
+
+#include <obsgroup/interrupt.h>
 
 #include <functional>
 #include <string>
@@ -10,26 +15,37 @@ namespace obsgroup::io {
 
 class OutputFolder {
  public:
-  /// Creates the folder if needed. Throws UsageError if it already holds
-  /// results and `force` is false, or if the path is not a folder.
-  OutputFolder(std::string path, bool force);
+  /// Checks the folder (see check()) and creates the staging folder beside
+  /// it. Every write() checks `interrupt` first and throws Interrupted.
+  OutputFolder(const std::string& path, bool force, const InterruptFlag* interrupt = nullptr);
+  /// Removes the staging folder unless commit() succeeded.
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
 
-  /// The checks of the constructor, without creating anything.
+  /// Throws UsageError if `path` is not a folder, holds results and `force`
+  /// is false, or holds anything obsgroup did not write. Creates nothing.
   static void check(const std::string& path, bool force);
 
-  /// The full path of a file in the folder.
+  /// The staging path of a file of the results.
   std::string path(const std::string& relative) const;
 
-  /// Writes `relative` through `write`, which is given a temporary path in
-  /// the same folder to write to; the file then replaces `relative` at once.
-  void write(const std::string& relative, const std::function<void(const std::string& temporary)>& write) const;
+  /// Writes `relative` through `write`, which is given the path to write to.
+  void write(const std::string& relative, const std::function<void(const std::string& path)>& write) const;
   void writeText(const std::string& relative, const std::string& content) const;
 
-  /// The files a run writes; their presence means the folder holds results.
+  /// Puts the staged results in place of the folder in one step, then
+  /// removes the old results.
+  void commit();
+
+  /// The entries a run writes; their presence means the folder holds results.
   static const char* const kResultFiles[];
 
  private:
-  std::string path_;
+  std::string target_;
+  std::string staging_;
+  const InterruptFlag* interrupt_ = nullptr;
+  bool committed_ = false;
 };
 
 }  // namespace obsgroup::io

@@ -113,7 +113,7 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
     checkPcdFile(files[k]);
     if (reader.read(files[k], *cloud) < 0)
       throw InputError(files[k] + ": cannot parse this PCD file (malformed header or truncated data)");
-    if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation");
+    if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation (a group of its own)");
     const Eigen::Isometry3d viewpoint = poseFromSensorOrigin(*cloud);
     identity_viewpoints += isIdentity(viewpoint);
     out.observations.push_back({cloud, poses ? (*poses)[k] : viewpoint});

@@ -1,6 +1,7 @@
 #include "result_writers.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace obsgroup::io {
@@ -21,6 +22,7 @@ nlohmann::json splitToJson(const SplitNode& node, std::size_t id) {
           {"threshold", node.attempted ? number(node.threshold) : nlohmann::json()},
           {"eigenvalue", number(node.eigenvalue)},
           {"solver", node.attempted ? (node.sparse_solver ? "sparse" : "dense") : nlohmann::json()},
+          {"solver_fell_back", node.solver_fell_back},
           {"children", node.children},
           {"members", node.members}};
 }
@@ -52,6 +54,7 @@ std::string partitionJson(const Partition& partition, const RunRecord& run) {
       << "  \"splits\": " << arrayPerLine(splits) << ",\n"
       << "  \"parameters\": " << run.parameters.dump() << ",\n"
       << "  \"statistics\": " << run.statistics.dump() << ",\n"
+      << "  \"warnings\": " << nlohmann::json(run.warnings).dump() << ",\n"
       << "  \"input\": " << nlohmann::json(run.input).dump() << ",\n"
       << "  \"timing_s\": " << run.timing_s.dump() << "\n"
       << "}\n";
@@ -77,6 +80,19 @@ std::string topologyJson(const TopologicalMap& map) {
                     {"overlapping_pairs", arc.overlapping_pairs},
                     {"sequence_pairs", arc.sequence_pairs}});
   return "{\n  \"nodes\": " + arrayPerLine(nodes) + ",\n  \"arcs\": " + arrayPerLine(arcs) + "\n}\n";
+}
+
+std::string localMapPosesTum(const TopologicalMap& map) {
+  std::string out = "# obsgroup local maps: group x y z qx qy qz qw (TUM), reference pose of local_maps/group_NNN.pcd\n";
+  char line[256];
+  for (std::size_t k = 0; k < map.nodes.size(); ++k) {
+    const Eigen::Quaterniond q(map.nodes[k].pose.linear());
+    const Eigen::Vector3d t = map.nodes[k].pose.translation();
+    std::snprintf(line, sizeof line, "%zu %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k, t.x(), t.y(), t.z(), q.x(),
+                  q.y(), q.z(), q.w());
+    out += line;
+  }
+  return out;
 }
 
 std::string topologyDot(const TopologicalMap& map) {

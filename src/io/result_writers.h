@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace obsgroup::io {
 
@@ -17,10 +18,11 @@ struct RunRecord {
   nlohmann::json parameters;  ///< every parameter actually used
   nlohmann::json statistics;  ///< points, pairs evaluated, edges of W
   nlohmann::json timing_s;    ///< seconds per stage (the only part that varies between runs)
+  std::vector<std::string> warnings;  ///< what the user was warned about, in order
 };
 
 /// {"observations": N, "groups": [[...]], "splits": [...], "parameters": {...},
-///  "statistics": {...}, "input": "...", "timing_s": {...}}, keys in this order,
+///  "statistics": {...}, "warnings": [...], "input": "...", "timing_s": {...}}, keys in this order,
 /// one group and one split per line.
 std::string partitionJson(const Partition& partition, const RunRecord& run);
 
@@ -29,6 +31,13 @@ std::string partitionJson(const Partition& partition, const RunRecord& run);
 /// "sequence_pairs"}]}; poses and transforms as x y z qw qx qy qz at full
 /// double precision.
 std::string topologyJson(const TopologicalMap& map);
+
+/// The reference pose of each local map, one TUM line per group in group
+/// order ("g x y z qx qy qz qw", the group number as timestamp), at full
+/// double precision: PCD VIEWPOINTs keep only 6 significant digits, which
+/// loses metres at UTM coordinates. local_maps/ with this file is a PCD
+/// sequence that `obsgroup partition --poses` reads back.
+std::string localMapPosesTum(const TopologicalMap& map);
 
 /// The same graph in GraphViz DOT.
 std::string topologyDot(const TopologicalMap& map);
