@@ -186,8 +186,11 @@ bool hasReturn(const LaserScan& scan) {
 }  // namespace
 
 CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
-  const std::string content = readWholeFile(path);
-  if (content.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path + ": the file is empty");
+  return parseCarmenLog(readWholeFile(path), path, options);
+}
+
+CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options) {
+  if (content.find_first_not_of(" \t\r\n") == std::string_view::npos) throw InputError(path + ": the file is empty");
 
   // First pass: which laser messages the log holds.
   std::map<LaserSource, std::size_t> counts;

@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace obsgroup::io {
@@ -51,6 +52,9 @@ struct CarmenLog {
 /// input (an empty file, a truncated line, a non-numeric field, a count of
 /// ranges that does not match the line, or no laser message at all).
 CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options = {});
+
+/// The same from a log's content already in memory; `path` names it in errors.
+CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options = {});
 
 /// The scan's returns as points in the laser frame (z = 0). Non-finite
 /// readings and readings at or beyond max_range give no point.

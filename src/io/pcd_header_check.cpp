@@ -39,7 +39,7 @@ Header readHeader(std::ifstream& in, const std::string& path) {
     if (f.empty() || f[0].front() == '#') continue;
     const LineRef where{path, number};
     const std::string key(f[0]);
-    seen.insert(key);
+    if (!seen.insert(key).second) throw inputError(path, number, "field '" + key + "' appears twice in the header");
     if (key == "VERSION") continue;
     if (key == "FIELDS") {
       h.fields = f.size() - 1;
@@ -53,9 +53,13 @@ Header readHeader(std::ifstream& in, const std::string& path) {
       }
     } else if (key == "TYPE") {
       checkCounts(f, h, where);
-      for (std::size_t k = 1; k < f.size(); ++k)
+      for (std::size_t k = 1; k < f.size(); ++k) {
         if (f[k] != "F" && f[k] != "I" && f[k] != "U")
           throw inputError(path, number, "field 'TYPE': '" + std::string(f[k]) + "' is not F, I or U");
+        if (f[k] == "F" && k <= sizes.size() && sizes[k - 1] != 4 && sizes[k - 1] != 8)
+          throw inputError(path, number, "field 'TYPE': F (float) with SIZE " + std::to_string(sizes[k - 1]) +
+                                             ": floats are 4 or 8 bytes");
+      }
     } else if (key == "COUNT") {
       checkCounts(f, h, where);
       for (std::size_t k = 1; k < f.size(); ++k) counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
@@ -81,6 +85,10 @@ Header readHeader(std::ifstream& in, const std::string& path) {
     if (!seen.count(required)) throw InputError(path + ": the PCD header has no " + required + " line");
   if (counts.empty()) counts.assign(h.fields, 1);
   for (std::size_t k = 0; k < h.fields; ++k) h.point_size += std::size_t(sizes[k] * counts[k]);
+  constexpr long kMaxPoints = 1L << 40;
+  if (h.height > 0 && h.width > kMaxPoints / h.height)
+    throw InputError(path + ": WIDTH * HEIGHT (" + std::to_string(h.width) + " * " + std::to_string(h.height) +
+                     ") is more points than any file holds");
   if (h.points < 0) h.points = h.width * h.height;
   if (h.points != h.width * h.height)
     throw InputError(path + ": field 'POINTS' (" + std::to_string(h.points) + ") is not WIDTH * HEIGHT (" +
@@ -97,6 +105,9 @@ void checkPcdFile(const std::string& path) {
   in.seekg(0, std::ios::end);
   const std::size_t size = static_cast<std::size_t>(in.tellg());
   const std::size_t available = size - h.data_offset;
+  if (h.point_size > 0 && std::size_t(h.points) > (std::size_t(1) << 50) / h.point_size)
+    throw InputError(path + ": the header declares " + std::to_string(h.points) + " points of " +
+                     std::to_string(h.point_size) + " bytes: more data than any file holds");
   const std::size_t expected = std::size_t(h.points) * h.point_size;
   const std::string truncated = path + ": truncated: the header declares " + std::to_string(h.points) + " points";
   if (h.data == "binary" && available < expected)

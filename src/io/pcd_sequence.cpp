@@ -48,6 +48,20 @@ bool naturalLess(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j || (a.size() - i == b.size() - j && a < b);
 }
 
+/// Runs a PCL reader call: its error status and whatever it throws on a
+/// malformed file (std::out_of_range from readHeader, for one) become an
+/// InputError naming the file.
+template <typename Call>
+void pclCall(const std::string& file, Call&& call, const std::string& message) {
+  int status = -1;
+  try {
+    status = call();
+  } catch (const std::exception& e) {
+    throw InputError(file + ": " + message + " (PCL: " + e.what() + ")");
+  }
+  if (status < 0) throw InputError(file + ": " + message);
+}
+
 bool isIdentity(const Eigen::Isometry3d& pose) {
   return (pose.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9;
 }
@@ -84,8 +98,8 @@ PointKind detectPointKind(const std::string& file) {
   Eigen::Quaternionf orientation;
   int version = 0, type = 0;
   unsigned int offset = 0;
-  if (reader.readHeader(file, header, origin, orientation, version, type, offset) < 0)
-    throw InputError(file + ": cannot parse the PCD header");
+  pclCall(file, [&] { return reader.readHeader(file, header, origin, orientation, version, type, offset); },
+          "cannot parse the PCD header");
   bool has_x = false, has_y = false, has_z = false, intensity = false, rgb = false;
   for (const auto& field : header.fields) {
     has_x = has_x || field.name == "x";
@@ -111,8 +125,19 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
   for (std::size_t k = 0; k < files.size(); ++k) {
     typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
     checkPcdFile(files[k]);
-    if (reader.read(files[k], *cloud) < 0)
-      throw InputError(files[k] + ": cannot parse this PCD file (malformed header or truncated data)");
+    pcl::PCLPointCloud2 blob;
+    int version = 0;
+    pclCall(files[k], [&] { return reader.read(files[k], blob, cloud->sensor_origin_, cloud->sensor_orientation_, version); },
+            "cannot parse this PCD file (malformed header or truncated data)");
+    // pcl::fromPCLPointCloud2 indexes point 0 of an empty cloud (PCL 1.13):
+    // what pcl::PCDReader::read<PointT> does, minus that.
+    if (blob.width * blob.height > 0) {
+      const Eigen::Vector4f origin = cloud->sensor_origin_;
+      const Eigen::Quaternionf orientation = cloud->sensor_orientation_;
+      pcl::fromPCLPointCloud2(blob, *cloud);
+      cloud->sensor_origin_ = origin;
+      cloud->sensor_orientation_ = orientation;
+    }
     if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation (a group of its own)");
     const Eigen::Isometry3d viewpoint = poseFromSensorOrigin(*cloud);
     identity_viewpoints += isIdentity(viewpoint);

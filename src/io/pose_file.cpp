@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace obsgroup::io {
@@ -53,14 +54,25 @@ Eigen::Isometry3d parseKitti(const std::vector<std::string_view>& f, const LineR
 }  // namespace
 
 std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat format) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the poses file");
+  std::ostringstream content;
+  content << in.rdbuf();
+  return parsePoses(content.str(), path, format);
+}
+
+std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format) {
   const std::size_t expected = format == PoseFormat::Tum ? 8 : 12;
   const std::string layout = format == PoseFormat::Tum ? "TUM: timestamp tx ty tz qx qy qz qw"
                                                        : "KITTI: 12 values of a 3x4 [R|t] matrix";
   std::vector<Eigen::Isometry3d> poses;
-  std::string line;
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < content.size();) {
+    std::size_t end = content.find('\n', start);
+    if (end == std::string_view::npos) end = content.size();
+    const std::string_view line = content.substr(start, end - start);
+    start = end + 1;
+    ++number;
     const auto fields = splitFields(line);
     if (fields.empty() || fields[0].front() == '#') continue;
     const LineRef where{path, number};

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace obsgroup::io {
@@ -19,6 +20,9 @@ std::string toString(PoseFormat format);
 /// rotation matrix that is not one. Small deviations (|q| within 1% of 1, a
 /// matrix within 1e-2 of orthonormal) are normalised silently.
 std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat format);
+
+/// The same from a file's content already in memory; `path` names it in errors.
+std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format);
 
 /// The rotation of a quaternion given as (w, x, y, z), normalised; throws
 /// std::invalid_argument when its norm is not within 1% of 1.
