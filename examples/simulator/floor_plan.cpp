@@ -9,7 +9,9 @@
 namespace obsgroup::sim {
 
 namespace {
-std::int64_t cellKey(long cx, long cy) { return (std::int64_t(cx) << 32) ^ (std::int64_t(cy) & 0xffffffff); }
+std::int64_t cellKey(long cx, long cy) {
+  return std::int64_t((std::uint64_t(cx) << 32) ^ (std::uint64_t(cy) & 0xffffffffu));  // unsigned: no UB for cx < 0
+}
 }  // namespace
 
 void FloorPlan::addBox(double x0, double y0, double x1, double y1) {
