@@ -718,3 +718,16 @@ TEST_F(Cli, RunsAreByteIdenticalApartFromTimings) {
   b["partition.json"] = strip(b["partition.json"]);
   EXPECT_EQ(a, b);  // every file: JSON, DOT, PCD, PNG and SVG
 }
+
+TEST_F(Cli, AScanFarFromTheOthersIsNamedByItsLine) {
+  // One pose 1e12 m away (a corrupt log): beyond the grid's reach at delta 0.1.
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string log, line;
+  for (int k = 1; std::getline(in, line); ++k) log += (k == 3 ? shiftedRobotLaserLog(line, 1e12, 0) : line + "\n");
+  writeFile(dir_ / "far.clf", log);
+  const Result r = run("partition " + (dir_ / "far.clf").string() + " -q -o " + (dir_ / "o").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("far.clf:3: observation 2: shared grid: a point lies too far"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+

@@ -91,6 +91,8 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   Partition partition;
   try {
     partition = grouping.compute();
+  } catch (const InvalidObservation& e) {
+    throw io::InputError(input.labels[e.index()] + ": " + e.what());
   } catch (const std::invalid_argument& e) {
     throw io::InputError(args.input + ": " + e.what());
   }

@@ -1,5 +1,7 @@
 #include "obsgroup/overlap/shared_grid_matcher.h"
 
+#include "obsgroup/invalid_observation.h"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -125,9 +127,14 @@ class Grid {
       std::uint32_t index;
     };
     std::vector<Entry> entries(total);
-    for (int i = 0; i < world_.size(); ++i)
-      for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
-        entries[k] = Entry{cellOf(world_.points[k]), i, static_cast<std::uint32_t>(k)};
+    for (int i = 0; i < world_.size(); ++i) {
+      try {
+        for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
+          entries[k] = Entry{cellOf(world_.points[k]), i, static_cast<std::uint32_t>(k)};
+      } catch (const std::invalid_argument& e) {
+        throw InvalidObservation(i, e.what());
+      }
+    }
     // Sorting by (cell, observation, index) groups each cell's points into one
     // run per observation, in a deterministic order.
     std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
