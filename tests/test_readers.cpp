@@ -79,6 +79,25 @@ TEST_F(PcdFolder, FloatOfTwoBytesIsRefused) {
   EXPECT_NE(message.find("000000.pcd:4: field 'TYPE': F (float) with SIZE 2"), std::string::npos) << message;
 }
 
+// Found by fuzz_pcd (in CI): a field with COUNT 0 made PCL read past the
+// end of each point's data (heap-buffer-overflow).
+TEST_F(PcdFolder, FieldCountedZeroIsRefused) {
+  const std::string message = errorOf(
+      "VERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 0 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+      "POINTS 1\nDATA ascii\n1 2 3\n");
+  EXPECT_NE(message.find("000000.pcd:5: field 'COUNT': a field counted 0 holds no value"), std::string::npos)
+      << message;
+}
+
+// PCL skips a field whose type differs from the point type's, silently:
+// double coordinates would all load as 0.
+TEST_F(PcdFolder, CoordinatesThatAreNotFloatsAreRefused) {
+  const std::string message = errorOf(
+      "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\n"
+      "DATA ascii\n1 2 3\n");
+  EXPECT_NE(message.find("field 'x' is not one 4-byte float"), std::string::npos) << message;
+}
+
 TEST_F(PcdFolder, HeadersNoFileCouldMatchAreRefused) {
   EXPECT_NE(errorOf(header("4 4 4", "1099511627776", "1099511627776", "0")).find("more points than any file holds"),
             std::string::npos);

@@ -62,7 +62,11 @@ Header readHeader(std::ifstream& in, const std::string& path) {
       }
     } else if (key == "COUNT") {
       checkCounts(f, h, where);
-      for (std::size_t k = 1; k < f.size(); ++k) counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
+      for (std::size_t k = 1; k < f.size(); ++k) {
+        counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
+        // PCL reads past the data of a field counted 0 (found by fuzzing).
+        if (counts.back() == 0) throw inputError(path, number, "field 'COUNT': a field counted 0 holds no value");
+      }
     } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
       if (f.size() != 2) throw inputError(path, number, "field '" + key + "' needs one value");
       const long v = parseCount(f[1], where, key, 1L << 40);

@@ -62,6 +62,19 @@ void pclCall(const std::string& file, Call&& call, const std::string& message) {
   if (status < 0) throw InputError(file + ": " + message);
 }
 
+/// x, y and z must be single 4-byte floats: PCL silently skips a field of
+/// another type (doubles would load as points all at 0, a wrong map).
+void checkCoordinateFields(const pcl::PCLPointCloud2& header, const std::string& file) {
+  for (const char* name : {"x", "y", "z"}) {
+    const auto field = std::find_if(header.fields.begin(), header.fields.end(),
+                                    [name](const pcl::PCLPointField& f) { return f.name == name; });
+    if (field == header.fields.end()) throw InputError(file + ": field '" + name + "' is missing from FIELDS");
+    if (field->datatype != pcl::PCLPointField::FLOAT32 || field->count != 1)
+      throw InputError(file + ": field '" + name + "' is not one 4-byte float (TYPE F, SIZE 4, COUNT 1); " +
+                       "obsgroup reads x y z as PCL's PointXYZ does");
+  }
+}
+
 bool isIdentity(const Eigen::Isometry3d& pose) {
   return (pose.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9;
 }
@@ -100,15 +113,15 @@ PointKind detectPointKind(const std::string& file) {
   unsigned int offset = 0;
   pclCall(file, [&] { return reader.readHeader(file, header, origin, orientation, version, type, offset); },
           "cannot parse the PCD header");
-  bool has_x = false, has_y = false, has_z = false, intensity = false, rgb = false;
+  checkCoordinateFields(header, file);
+  bool intensity = false, rgb = false;
   for (const auto& field : header.fields) {
-    has_x = has_x || field.name == "x";
-    has_y = has_y || field.name == "y";
-    has_z = has_z || field.name == "z";
-    intensity = intensity || field.name == "intensity";
-    rgb = rgb || field.name == "rgb" || field.name == "rgba";
+    // Only fields PCL can map onto the point type: anything else is left out.
+    intensity = intensity || (field.name == "intensity" && field.datatype == pcl::PCLPointField::FLOAT32 &&
+                              field.count == 1);
+    rgb = rgb || ((field.name == "rgb" || field.name == "rgba") && field.count == 1 &&
+                  (field.datatype == pcl::PCLPointField::FLOAT32 || field.datatype == pcl::PCLPointField::UINT32));
   }
-  if (!(has_x && has_y && has_z)) throw InputError(file + ": field 'x', 'y' or 'z' is missing from FIELDS");
   return rgb ? PointKind::XYZRGB : (intensity ? PointKind::XYZI : PointKind::XYZ);
 }
 
@@ -129,6 +142,7 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
     int version = 0;
     pclCall(files[k], [&] { return reader.read(files[k], blob, cloud->sensor_origin_, cloud->sensor_orientation_, version); },
             "cannot parse this PCD file (malformed header or truncated data)");
+    checkCoordinateFields(blob, files[k]);  // every file, not only the first
     // pcl::fromPCLPointCloud2 indexes point 0 of an empty cloud (PCL 1.13):
     // what pcl::PCDReader::read<PointT> does, minus that.
     if (blob.width * blob.height > 0) {
