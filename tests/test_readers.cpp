@@ -98,6 +98,15 @@ TEST_F(PcdFolder, CoordinatesThatAreNotFloatsAreRefused) {
   EXPECT_NE(message.find("field 'x' is not one 4-byte float"), std::string::npos) << message;
 }
 
+// Found by fuzz_pcd: PCL reads header keys after DATA (past empty and
+// comment lines), so it read the data with fields the check never saw and
+// overflowed its buffer.
+TEST_F(PcdFolder, HeaderKeysAfterDataAreRefused) {
+  const std::string message = errorOf(header("4 4 4", "1", "1", "1") + "\n# a comment\nFIELDS x y z a b c\n1 2 3\n");
+  EXPECT_NE(message.find("000000.pcd:13: header field 'FIELDS' after DATA"), std::string::npos) << message;
+  EXPECT_EQ(errorOf(header("4 4 4", "1", "1", "1") + "1 2 3\n"), "");
+}
+
 TEST_F(PcdFolder, HeadersNoFileCouldMatchAreRefused) {
   EXPECT_NE(errorOf(header("4 4 4", "1099511627776", "1099511627776", "0")).find("more points than any file holds"),
             std::string::npos);

@@ -28,6 +28,27 @@ void checkCounts(const std::vector<std::string_view>& f, const Header& h, const 
                          std::to_string(h.fields) + " FIELDS");
 }
 
+/// PCL's readHeader does not stop at DATA: it reads on through empty and
+/// comment lines, and a header key there replaces the one before, so PCL
+/// would read the data with other fields than those checked here (a heap
+/// overflow in fromPCLPointCloud2; found by fuzzing). Such a file is refused.
+void refuseHeaderAfterData(std::ifstream& in, const std::string& path, std::size_t data_line) {
+  static const char* kKeys[] = {"VERSION", "FIELDS", "COLUMNS", "SIZE",   "TYPE",
+                                "COUNT",   "WIDTH",  "HEIGHT",  "VIEWPOINT", "POINTS", "DATA"};
+  const std::streampos start = in.tellg();
+  std::string line;
+  for (std::size_t number = data_line + 1; number <= data_line + 64 && std::getline(in, line); ++number) {
+    const auto f = splitFields(line);
+    if (f.empty() || f[0].front() == '#') continue;  // PCL reads on past these
+    for (const char* key : kKeys)
+      if (f[0].substr(0, std::strlen(key)) == key)
+        throw inputError(path, number, "header field '" + std::string(key) + "' after DATA: not a PCD file");
+    break;
+  }
+  in.clear();
+  in.seekg(start);
+}
+
 Header readHeader(std::ifstream& in, const std::string& path) {
   Header h;
   std::vector<long> sizes, counts;
@@ -79,6 +100,7 @@ Header readHeader(std::ifstream& in, const std::string& path) {
         throw inputError(path, number, "field 'DATA' must be ascii, binary or binary_compressed");
       h.data = std::string(f[1]);
       h.data_offset = static_cast<std::size_t>(in.tellg());
+      refuseHeaderAfterData(in, path, number);
       break;
     } else {
       throw inputError(path, number, "unknown header field '" + key + "': not a PCD header");

@@ -4,6 +4,7 @@
 #include "pcd_header_check.h"
 
 #include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
@@ -75,6 +76,21 @@ void checkCoordinateFields(const pcl::PCLPointCloud2& header, const std::string&
   }
 }
 
+/// What PCL read must hold the points its header declares, each field inside
+/// a point: pcl::fromPCLPointCloud2 trusts both and copies out of bounds
+/// otherwise. The header check should make this unreachable; it is the
+/// last guard should PCL parse a file differently from it.
+void checkBlobSize(const pcl::PCLPointCloud2& blob, const std::string& file) {
+  const std::size_t points = std::size_t(blob.width) * blob.height;
+  if (blob.point_step == 0 ? points > 0 : blob.data.size() / blob.point_step < points)
+    throw InputError(file + ": PCL read " + std::to_string(blob.data.size()) + " bytes for " + std::to_string(points) +
+                     " points of " + std::to_string(blob.point_step) + " bytes: malformed or truncated");
+  for (const auto& field : blob.fields)
+    if (std::size_t(field.offset) + std::size_t(pcl::getFieldSize(field.datatype)) * field.count > blob.point_step)
+      throw InputError(file + ": field '" + field.name + "' lies outside the point's " +
+                       std::to_string(blob.point_step) + " bytes: malformed header");
+}
+
 bool isIdentity(const Eigen::Isometry3d& pose) {
   return (pose.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-9;
 }
@@ -143,6 +159,7 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
     pclCall(files[k], [&] { return reader.read(files[k], blob, cloud->sensor_origin_, cloud->sensor_orientation_, version); },
             "cannot parse this PCD file (malformed header or truncated data)");
     checkCoordinateFields(blob, files[k]);  // every file, not only the first
+    checkBlobSize(blob, files[k]);
     // pcl::fromPCLPointCloud2 indexes point 0 of an empty cloud (PCL 1.13):
     // what pcl::PCDReader::read<PointT> does, minus that.
     if (blob.width * blob.height > 0) {
