@@ -105,6 +105,9 @@ TEST_F(PcdFolder, HeaderKeysAfterDataAreRefused) {
   const std::string message = errorOf(header("4 4 4", "1", "1", "1") + "\n# a comment\nFIELDS x y z a b c\n1 2 3\n");
   EXPECT_NE(message.find("000000.pcd:13: header field 'FIELDS' after DATA"), std::string::npos) << message;
   EXPECT_EQ(errorOf(header("4 4 4", "1", "1", "1") + "1 2 3\n"), "");
+  // However many empty lines come first: PCL reads on through all of them.
+  const std::string far = errorOf(header("4 4 4", "1", "1", "1") + std::string(200, '\n') + "FIELDS x y z a\n1 2 3\n");
+  EXPECT_NE(far.find(":211: header field 'FIELDS' after DATA"), std::string::npos) << far;
 }
 
 TEST_F(PcdFolder, HeadersNoFileCouldMatchAreRefused) {

@@ -37,7 +37,7 @@ void refuseHeaderAfterData(std::ifstream& in, const std::string& path, std::size
                                 "COUNT",   "WIDTH",  "HEIGHT",  "VIEWPOINT", "POINTS", "DATA"};
   const std::streampos start = in.tellg();
   std::string line;
-  for (std::size_t number = data_line + 1; number <= data_line + 64 && std::getline(in, line); ++number) {
+  for (std::size_t number = data_line + 1; std::getline(in, line); ++number) {  // as far as PCL reads
     const auto f = splitFields(line);
     if (f.empty() || f[0].front() == '#') continue;  // PCL reads on past these
     for (const char* key : kKeys)
