@@ -110,6 +110,18 @@ TEST_F(PcdFolder, HeaderKeysAfterDataAreRefused) {
   EXPECT_NE(far.find(":211: header field 'FIELDS' after DATA"), std::string::npos) << far;
 }
 
+// Found by fuzz_pcd: with 0 points declared, PCL still allocates the
+// uncompressed size written in the data (1.3 GB from 8 forged bytes).
+TEST_F(PcdFolder, CompressedSizesAreCheckedEvenForNoPoints) {
+  const std::string forged("\x22\0\0\0\x40\x49\x4f\x50", 8);
+  const std::string message = errorOf("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4\n"
+                                      "HEIGHT 0\nDATA binary_compressed\n" + forged);
+  EXPECT_NE(message.find("compressed data"), std::string::npos) << message;
+  EXPECT_NE(errorOf("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+                    "DATA binary"),
+            "") << "DATA as the last line, without data, must be refused as truncated";
+}
+
 TEST_F(PcdFolder, HeadersNoFileCouldMatchAreRefused) {
   EXPECT_NE(errorOf(header("4 4 4", "1099511627776", "1099511627776", "0")).find("more points than any file holds"),
             std::string::npos);

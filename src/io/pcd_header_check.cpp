@@ -99,7 +99,13 @@ Header readHeader(std::ifstream& in, const std::string& path) {
       if (f.size() != 2 || (f[1] != "ascii" && f[1] != "binary" && f[1] != "binary_compressed"))
         throw inputError(path, number, "field 'DATA' must be ascii, binary or binary_compressed");
       h.data = std::string(f[1]);
-      h.data_offset = static_cast<std::size_t>(in.tellg());
+      std::streampos after = in.tellg();
+      if (after < 0) {  // DATA was the last line, with no newline: no data
+        in.clear();
+        in.seekg(0, std::ios::end);
+        after = in.tellg();
+      }
+      h.data_offset = static_cast<std::size_t>(after);
       refuseHeaderAfterData(in, path, number);
       break;
     } else {
@@ -139,7 +145,10 @@ void checkPcdFile(const std::string& path) {
   if (h.data == "binary" && available < expected)
     throw InputError(truncated + " (" + std::to_string(expected) + " bytes), the file holds " +
                      std::to_string(available));
-  if (h.data == "binary_compressed" && h.points > 0) {
+  // Even for 0 points: PCL reads the two sizes and allocates the
+  // uncompressed one as given (a 1.3 GB allocation from 8 forged bytes; found
+  // by fuzzing).
+  if (h.data == "binary_compressed") {
     std::uint32_t sizes[2] = {0, 0};  // compressed, uncompressed
     in.seekg(static_cast<std::streamoff>(h.data_offset));
     in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
