@@ -2,6 +2,7 @@
 // behaviour on bad input: a one-line error naming file, line and field, exit
 // code 2 for usage errors and 3 for input errors.
 #include "floor_plan.h"
+#include "temp_folder.h"
 
 #include <cairo.h>
 #include <nlohmann/json.hpp>
@@ -47,15 +48,9 @@ void writeFile(const fs::path& path, const std::string& content) {
   std::ofstream(path, std::ios::binary) << content;
 }
 
-/// A fresh folder per test, removed afterwards.
-class Cli : public ::testing::Test {
+/// A fresh folder per test (dir_), removed afterwards.
+class Cli : public obsgroup::test::TempFolderTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "obsgroup_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   Result run(const std::string& args) const {
     const fs::path err = dir_ / "stderr.txt";
@@ -63,8 +58,6 @@ class Cli : public ::testing::Test {
     const int status = std::system(command.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readFile(err)};
   }
-
-  fs::path dir_;
 };
 
 nlohmann::json readJson(const fs::path& path) { return nlohmann::json::parse(readFile(path)); }

@@ -4,6 +4,7 @@
 #include "errors.h"
 #include "pcd_sequence.h"
 #include "pose_file.h"
+#include "temp_folder.h"
 
 #include <pcl/point_types.h>
 
@@ -20,14 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 /// A one-file PCD folder holding `content`, removed afterwards.
-class PcdFolder : public ::testing::Test {
+class PcdFolder : public obsgroup::test::TempFolderTest {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "obsgroup_readers_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string write(const std::string& content) const {
     const fs::path file = dir_ / "000000.pcd";
@@ -46,8 +41,6 @@ class PcdFolder : public ::testing::Test {
     }
     return "";
   }
-
-  fs::path dir_;
 };
 
 std::string header(const std::string& size, const std::string& width, const std::string& height,
