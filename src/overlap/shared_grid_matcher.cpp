@@ -9,11 +9,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
-#include <utility>
 
 namespace obsgroup {
 namespace {
@@ -21,9 +20,8 @@ namespace {
 struct CellKey {
   std::int32_t x, y, z;
   bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
-  bool operator<(const CellKey& o) const {
-    return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z);
-  }
+  bool operator<(const CellKey& o) const { return x != o.x ? x < o.x : (y != o.y ? y < o.y : z < o.z); }
+  bool operator<=(const CellKey& o) const { return !(o < *this); }
 };
 
 /// A run of consecutive grid points of one observation inside one cell.
@@ -32,60 +30,77 @@ struct Run {
   std::uint32_t begin, end;  // into Grid::points
 };
 
-/// What the grid knows of one cell.
-struct CellRuns {
-  std::uint32_t begin = 0, end = 0;  ///< the cell's runs, [begin, end) into the run array
-  std::uint32_t ordinal = 0;         ///< the cell's number, in key order
+/// [begin, end) of some array.
+struct Span {
+  std::uint32_t begin = 0, end = 0;
+  std::uint32_t size() const { return end - begin; }
 };
 
-/// Open-addressing hash table from a cell to its runs. Built once, read-only
-/// afterwards, so all threads share it without locks.
-class CellTable {
- public:
-  void reserve(std::size_t cells) {
-    std::size_t capacity = 16;
-    while (capacity < 2 * cells) capacity <<= 1;
-    mask_ = capacity - 1;
-    slots_.assign(capacity, Slot{});
-  }
-  void insert(const CellKey& key, const CellRuns& runs) {
-    std::size_t s = hash(key) & mask_;
-    while (slots_[s].runs.end != 0) s = (s + 1) & mask_;
-    slots_[s] = Slot{key, runs};
-  }
-  /// The cell's runs; begin == end if the cell is empty.
-  CellRuns find(const CellKey& key) const {
-    for (std::size_t s = hash(key) & mask_;; s = (s + 1) & mask_) {
-      const Slot& slot = slots_[s];
-      if (slot.runs.end == 0) return {};
-      if (slot.key == key) return slot.runs;
+/// One world point and its cell, the unit the grid sorts.
+struct Entry {
+  CellKey key;
+  std::uint32_t index;  // into WorldPoints::points, which is in observation order
+};
+
+/// Stable LSD radix sort by cell key (x, then y, then z), 11 bits per pass
+/// and only as many passes as the extent of the map needs; entries that share
+/// a cell keep their input order. O(n), and the same for any thread count.
+void sortByCell(std::vector<Entry>& entries) {
+  std::vector<Entry> buffer(entries.size());
+  const auto coordinate = [](const Entry& e, int axis) { return axis == 0 ? e.key.x : axis == 1 ? e.key.y : e.key.z; };
+  for (int axis = 2; axis >= 0; --axis) {  // least significant key first
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = std::numeric_limits<std::int32_t>::min();
+    for (const Entry& e : entries) {
+      lo = std::min(lo, coordinate(e, axis));
+      hi = std::max(hi, coordinate(e, axis));
+    }
+    const std::uint32_t extent = entries.empty() ? 0 : std::uint32_t(std::int64_t(hi) - lo);
+    for (int shift = 0; shift < 32 && (extent >> shift) != 0; shift += 11) {
+      const auto digit = [&](const Entry& e) { return (std::uint32_t(std::int64_t(coordinate(e, axis)) - lo) >> shift) & 2047u; };
+      std::array<std::size_t, 2049> start{};
+      for (const Entry& e : entries) ++start[digit(e) + 1];
+      for (std::size_t d = 0; d < 2048; ++d) start[d + 1] += start[d];
+      for (const Entry& e : entries) buffer[start[digit(e)]++] = e;
+      entries.swap(buffer);
     }
   }
+}
 
- private:
-  struct Slot {
-    CellKey key{0, 0, 0};
-    CellRuns runs;  // runs.end == 0 marks a free slot
-  };
-  static std::size_t hash(const CellKey& k) {
-    std::uint64_t h = std::uint64_t(std::uint32_t(k.x)) * 0x9E3779B97F4A7C15ull;
-    h ^= std::uint64_t(std::uint32_t(k.y)) * 0xC2B2AE3D27D4EB4Full;
-    h ^= std::uint64_t(std::uint32_t(k.z)) * 0x165667B19E3779F9ull;
-    return static_cast<std::size_t>(h ^ (h >> 29));
-  }
-  std::vector<Slot> slots_;
-  std::size_t mask_ = 0;
-};
-
+/// Every world point sorted by (cell, observation), cut into runs, plus for
+/// each cell the runs of its neighbourhood. Cells sorted by key make the
+/// neighbourhood a few contiguous slices of the run array: in a column of
+/// cells that differ only in the last coordinate (z, or y for flat data), the
+/// cells -1, 0, +1 follow each other in key order, so the 3x3 (flat) or 3x3x3
+/// neighbourhood is 3 or 9 slices, found without a hash table.
 class Grid {
  public:
-  Grid(const WorldPoints& world, double delta) : world_(world) {
+  Grid(const WorldPoints& world, double delta, int threads) : world_(world), threads_(threads) {
     // Cells a hair larger than delta: two points within delta then differ by
     // at most one in every cell index, whatever the rounding of x / cell.
     inv_cell_ = 1.0 / (delta * (1.0 + 1e-6));
     build();
   }
 
+  std::size_t cells() const { return cell_runs_.size(); }
+  int columns() const { return columns_; }
+  /// The run slices of a cell's neighbourhood (columns() of them).
+  const Span* neighbourhood(std::size_t cell) const { return &neighbourhood_[cell * columns_]; }
+  /// Distinct observations with points in the neighbourhood of a cell.
+  std::uint32_t observationsNear(std::size_t cell) const { return observations_near_[cell]; }
+  Span runsOfCell(std::size_t cell) const { return cell_runs_[cell]; }
+  std::uint32_t pointsOfCell(std::size_t cell) const {
+    return runs_[cell_runs_[cell].end - 1].end - runs_[cell_runs_[cell].begin].begin;
+  }
+  std::uint32_t firstPointOfCell(std::size_t cell) const { return runs_[cell_runs_[cell].begin].begin; }
+  const std::vector<Run>& runs() const { return runs_; }
+  std::uint32_t cellOfRun(std::uint32_t run) const { return run_cell_[run]; }
+  /// The runs of observation i, in cell order.
+  Span runsOf(int i) const { return {observation_run_offsets_[i], observation_run_offsets_[i + 1]}; }
+  std::uint32_t observationRun(std::uint32_t k) const { return observation_runs_[k]; }
+  const std::vector<Eigen::Vector3f>& points() const { return points_; }
+  int observations() const { return world_.size(); }
+
+ private:
   CellKey cellOf(const Eigen::Vector3f& p) const {
     const auto index = [this](float v) {
       const double c = std::floor(double(v) * inv_cell_);
@@ -98,181 +113,333 @@ class Grid {
     return {index(p.x()), index(p.y()), index(p.z())};
   }
 
-  bool flat() const { return flat_; }
-  const CellTable& table() const { return table_; }
-  /// Distinct observations with points in the neighbourhood of a cell (by ordinal).
-  std::uint32_t observationsNear(std::uint32_t ordinal) const { return observations_near_[ordinal]; }
-  /// Calls f(runs) for each non-empty cell of the 3x3 (flat) or 3x3x3 neighbourhood of c.
-  template <typename F>
-  void forEachNeighbour(const CellKey& c, F&& f) const {
-    const int dz_max = flat_ ? 0 : 1;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -dz_max; dz <= dz_max; ++dz) {
-          const CellRuns runs = table_.find({c.x + dx, c.y + dy, c.z + dz});
-          if (runs.begin != runs.end) f(runs);
-        }
-  }
-  const std::vector<Run>& runs() const { return runs_; }
-  const std::vector<Eigen::Vector3f>& points() const { return points_; }
-
- private:
-  void build() {
+  std::vector<Entry> cellEntries() const {
     const std::size_t total = world_.points.size();
     if (total >= std::numeric_limits<std::uint32_t>::max())
       throw std::invalid_argument("shared grid: more than 4 billion points");
-    struct Entry {
-      CellKey key;
-      std::int32_t observation;
-      std::uint32_t index;
-    };
     std::vector<Entry> entries(total);
-    for (int i = 0; i < world_.size(); ++i) {
+    const int n = world_.size();
+    int first_bad = n;  // the lowest failing observation is reported, whatever the threads
+    std::string why;
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 64)
+    for (int i = 0; i < n; ++i) {
       try {
         for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
-          entries[k] = Entry{cellOf(world_.points[k]), i, static_cast<std::uint32_t>(k)};
+          entries[k] = Entry{cellOf(world_.points[k]), static_cast<std::uint32_t>(k)};
       } catch (const std::invalid_argument& e) {
-        throw InvalidObservation(i, e.what());
+#pragma omp critical(obsgroup_grid_error)
+        if (i < first_bad) {
+          first_bad = i;
+          why = e.what();
+        }
       }
     }
-    // Sorting by (cell, observation, index) groups each cell's points into one
-    // run per observation, in a deterministic order.
-    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-      if (!(a.key == b.key)) return a.key < b.key;
-      return a.observation != b.observation ? a.observation < b.observation : a.index < b.index;
-    });
-    points_.resize(total);
-    flat_ = true;
-    std::size_t cells = 0;
-    for (std::size_t k = 0; k < total; ++k) {
-      points_[k] = world_.points[entries[k].index];
-      flat_ = flat_ && entries[k].key.z == entries[0].key.z;
-      if (k == 0 || !(entries[k].key == entries[k - 1].key)) ++cells;
-    }
-    table_.reserve(cells);
-    std::vector<CellKey> keys;
-    keys.reserve(cells);
-    std::uint32_t cell_first_run = 0;
-    const auto close_cell = [&](const CellKey& key) {
-      table_.insert(key, {cell_first_run, static_cast<std::uint32_t>(runs_.size()),
-                          static_cast<std::uint32_t>(keys.size())});
-      keys.push_back(key);
-    };
-    for (std::size_t k = 0; k < total; ++k) {
-      const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
-      if (new_cell && k > 0) close_cell(entries[k - 1].key);
-      if (new_cell) cell_first_run = static_cast<std::uint32_t>(runs_.size());
-      if (new_cell || entries[k].observation != entries[k - 1].observation)
-        runs_.push_back(Run{entries[k].observation, static_cast<std::uint32_t>(k), 0});
-      runs_.back().end = static_cast<std::uint32_t>(k + 1);
-    }
-    if (total > 0) close_cell(entries[total - 1].key);
-    countObservationsNear(keys);
+    if (first_bad < n) throw InvalidObservation(first_bad, why);
+    return entries;
   }
 
-  /// For each cell, the distinct observations in its neighbourhood: every
-  /// point of the cell is tested once against each of them but its own, so
-  /// the work statistic costs nothing in the per-point loop.
-  void countObservationsNear(const std::vector<CellKey>& keys) {
-    observations_near_.assign(keys.size(), 0);
-#pragma omp parallel
+  void build() {
+    std::vector<Entry> entries = cellEntries();
+    sortByCell(entries);
+    const std::size_t total = entries.size();
+    flat_ = std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.key.z == entries[0].key.z; });
+    columns_ = flat_ ? 3 : 9;
+    std::vector<std::int32_t> observation_of(total);
+    for (int i = 0; i < world_.size(); ++i)
+      std::fill(observation_of.begin() + world_.offsets[i], observation_of.begin() + world_.offsets[i + 1], i);
+    points_.resize(total);
+    std::vector<CellKey> keys;
+    for (std::size_t k = 0; k < total; ++k) {
+      points_[k] = world_.points[entries[k].index];
+      const std::int32_t observation = observation_of[entries[k].index];
+      const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
+      if (new_cell) {
+        keys.push_back(entries[k].key);
+        cell_runs_.push_back({static_cast<std::uint32_t>(runs_.size()), 0});
+      }
+      if (new_cell || observation != runs_.back().observation) {
+        runs_.push_back(Run{observation, static_cast<std::uint32_t>(k), 0});
+        run_cell_.push_back(static_cast<std::uint32_t>(keys.size() - 1));
+      }
+      runs_.back().end = static_cast<std::uint32_t>(k + 1);
+      cell_runs_.back().end = static_cast<std::uint32_t>(runs_.size());
+    }
+    entries = {};
+    indexRunsByObservation();
+    buildNeighbourhoods(keys);
+    countObservationsNear();
+  }
+
+  /// Each observation's runs in cell order: a counting sort of the runs.
+  void indexRunsByObservation() {
+    const int n = world_.size();
+    observation_run_offsets_.assign(n + 1, 0);
+    for (const Run& r : runs_) ++observation_run_offsets_[r.observation + 1];
+    for (int i = 0; i < n; ++i) observation_run_offsets_[i + 1] += observation_run_offsets_[i];
+    observation_runs_.resize(runs_.size());
+    std::vector<std::uint32_t> next(observation_run_offsets_.begin(), observation_run_offsets_.end() - 1);
+    for (std::uint32_t r = 0; r < runs_.size(); ++r) observation_runs_[next[runs_[r].observation]++] = r;
+  }
+
+  /// One merge-like sweep over the sorted cells per column offset: as the
+  /// cell advances in key order, the column's first and last cells only move
+  /// forward.
+  void buildNeighbourhoods(const std::vector<CellKey>& keys) {
+    const std::size_t cells = keys.size();
+    neighbourhood_.assign(cells * columns_, Span{});
+#pragma omp parallel for num_threads(threads_) schedule(static, 1)
+    for (int column = 0; column < columns_; ++column) {
+      const int dx = column % 3 - 1;
+      const int dy = column / 3 - 1;
+      std::size_t lo = 0, hi = 0;
+      for (std::size_t c = 0; c < cells; ++c) {
+        const CellKey& k = keys[c];
+        const CellKey first = flat_ ? CellKey{k.x + dx, k.y - 1, k.z} : CellKey{k.x + dx, k.y + dy, k.z - 1};
+        const CellKey last = flat_ ? CellKey{k.x + dx, k.y + 1, k.z} : CellKey{k.x + dx, k.y + dy, k.z + 1};
+        while (lo < cells && keys[lo] < first) ++lo;
+        hi = std::max(hi, lo);
+        while (hi < cells && keys[hi] <= last) ++hi;
+        if (lo < hi) neighbourhood_[c * columns_ + column] = {cell_runs_[lo].begin, cell_runs_[hi - 1].end};
+      }
+    }
+  }
+
+  void countObservationsNear() {
+    observations_near_.assign(cells(), 0);
+#pragma omp parallel num_threads(threads_)
     {
       std::vector<std::uint32_t> stamp(world_.size(), 0);
-#pragma omp for schedule(dynamic, 256)
-      for (std::size_t c = 0; c < keys.size(); ++c) {
+#pragma omp for schedule(dynamic, 1024)
+      for (std::size_t c = 0; c < cells(); ++c) {
         std::uint32_t distinct = 0;
         const std::uint32_t mark = static_cast<std::uint32_t>(c + 1);
-        forEachNeighbour(keys[c], [&](const CellRuns& runs) {
-          for (std::uint32_t r = runs.begin; r < runs.end; ++r) {
+        const Span* slices = neighbourhood(c);
+        for (int h = 0; h < columns_; ++h)
+          for (std::uint32_t r = slices[h].begin; r < slices[h].end; ++r) {
             std::uint32_t& s = stamp[runs_[r].observation];
-            if (s != mark) {
-              s = mark;
-              ++distinct;
-            }
+            distinct += s != mark;
+            s = mark;
           }
-        });
         observations_near_[c] = distinct;
       }
     }
   }
 
   const WorldPoints& world_;
+  int threads_;
   double inv_cell_ = 0.0;
   bool flat_ = true;
-  CellTable table_;
-  std::vector<Run> runs_;
+  int columns_ = 3;
   std::vector<Eigen::Vector3f> points_;
+  std::vector<Run> runs_;
+  std::vector<std::uint32_t> run_cell_;
+  std::vector<Span> cell_runs_;
+  std::vector<std::uint32_t> observation_run_offsets_, observation_runs_;
+  std::vector<Span> neighbourhood_;
   std::vector<std::uint32_t> observations_near_;
 };
+
+/// The outcome of matching every point against its cell's neighbourhood: for
+/// each cell c the distinct observations near it, J_c, and for each point of
+/// c the subset of J_c it matched (eq. 16), as a bit set of ceil(|J_c| / 64)
+/// words. Its own observation is never in its set.
+struct CellMatches {
+  std::vector<std::uint64_t> near_offsets;  ///< per cell, into near
+  std::vector<std::int32_t> near;           ///< J_c, cell after cell
+  std::vector<std::uint64_t> mask_offsets;  ///< per cell, into masks
+  std::vector<std::uint64_t> masks;         ///< per point of the cell, in grid order
+  std::uint64_t point_tests = 0;
+
+  std::size_t words(std::size_t cell) const { return (near_offsets[cell + 1] - near_offsets[cell] + 63) / 64; }
+};
+
+/// The float test of MatchDistance, written so that the compiler vectorises
+/// it; `border` tells whether some distance fell in the band where only the
+/// double test may decide.
+std::uint8_t floatMatches(const Eigen::Vector3f& p, float inside, float outside, const float* __restrict x,
+                          const float* __restrict y, const float* __restrict z, std::uint8_t* __restrict hit,
+                          std::uint32_t begin, std::uint32_t end) {
+  const float px = p.x(), py = p.y(), pz = p.z();
+  std::uint8_t border = 0;
+  for (std::uint32_t q = begin; q < end; ++q) {
+    const float dx = px - x[q], dy = py - y[q], dz = pz - z[q];
+    const float d = dx * dx + dy * dy + dz * dz;
+    hit[q] = d < inside;
+    border |= (d >= inside) & (d <= outside);
+  }
+  return border;
+}
+
+/// Whether any of hit[begin, end) is set; hit is readable 8 bytes past end.
+bool anyHit(const std::uint8_t* hit, std::uint32_t begin, std::uint32_t end) {
+  static constexpr std::uint8_t kTail[16] = {255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 0, 0, 0, 0, 0};
+  std::uint64_t any = 0, word, keep;
+  for (; begin + 8 <= end; begin += 8) {
+    std::memcpy(&word, hit + begin, 8);
+    any |= word;
+  }
+  if (begin < end) {
+    std::memcpy(&word, hit + begin, 8);
+    std::memcpy(&keep, kTail + 8 - (end - begin), 8);  // the first end - begin bytes, whatever the endianness
+    any |= word & keep;
+  }
+  return any != 0;
+}
+
+/// Per-thread scratch of the cell pass: the neighbourhood's points grouped by
+/// observation (group g holds the points of J_c[g]), in float arrays.
+struct NeighbourhoodScratch {
+  explicit NeighbourhoodScratch(int n) : mark(n, 0), group(n, 0) {}
+  std::vector<std::uint32_t> mark, group;  // stamp of the last cell that saw j, and j's group there
+  std::vector<std::uint32_t> group_begin, cursor;
+  std::vector<float> x, y, z;
+  std::vector<std::uint8_t> hit;
+};
+
+/// Fills J_c and the group layout of one cell's neighbourhood.
+std::uint32_t groupNeighbourhood(const Grid& grid, std::size_t c, std::int32_t* near, NeighbourhoodScratch& s) {
+  const std::vector<Run>& runs = grid.runs();
+  const Span* slices = grid.neighbourhood(c);
+  const std::uint32_t stamp = static_cast<std::uint32_t>(c + 1);
+  std::uint32_t groups = 0;
+  s.group_begin.assign(grid.observationsNear(c) + 1, 0);
+  for (int h = 0; h < grid.columns(); ++h)
+    for (std::uint32_t r = slices[h].begin; r < slices[h].end; ++r) {
+      const int j = runs[r].observation;
+      if (s.mark[j] != stamp) {
+        s.mark[j] = stamp;
+        s.group[j] = groups;
+        near[groups++] = j;
+      }
+      s.group_begin[s.group[j] + 1] += runs[r].end - runs[r].begin;
+    }
+  for (std::uint32_t g = 0; g < groups; ++g) s.group_begin[g + 1] += s.group_begin[g];
+  const std::uint32_t total = s.group_begin[groups];
+  s.x.resize(total);
+  s.y.resize(total);
+  s.z.resize(total);
+  s.hit.assign(total + 8, 0);
+  s.cursor.assign(s.group_begin.begin(), s.group_begin.end() - 1);
+  const Eigen::Vector3f* points = grid.points().data();
+  for (int h = 0; h < grid.columns(); ++h)
+    for (std::uint32_t r = slices[h].begin; r < slices[h].end; ++r) {
+      std::uint32_t& at = s.cursor[s.group[runs[r].observation]];
+      for (std::uint32_t q = runs[r].begin; q < runs[r].end; ++q, ++at) {
+        s.x[at] = points[q].x();
+        s.y[at] = points[q].y();
+        s.z[at] = points[q].z();
+      }
+    }
+  return groups;
+}
+
+/// Sets, in `mask`, the groups of the neighbourhood that have a point within
+/// delta of p, its own group `self` excepted.
+void matchPoint(const Eigen::Vector3f& p, std::uint32_t self, std::uint32_t groups, const MatchDistance& within,
+                float inside, float outside, NeighbourhoodScratch& s, std::uint64_t* mask) {
+  const std::uint32_t total = s.group_begin[groups];
+  const std::uint32_t own_begin = s.group_begin[self], own_end = s.group_begin[self + 1];
+  std::uint8_t* hit = s.hit.data();
+  std::uint8_t border = floatMatches(p, inside, outside, s.x.data(), s.y.data(), s.z.data(), hit, 0, own_begin);
+  border |= floatMatches(p, inside, outside, s.x.data(), s.y.data(), s.z.data(), hit, own_end, total);
+  if (border) {  // rare: a distance within 1e-4 of delta, decided in double
+    for (std::uint32_t q = 0; q < total; ++q) hit[q] = within(p, Eigen::Vector3f(s.x[q], s.y[q], s.z[q]));
+  }
+  for (std::uint32_t g = 0; g < groups; ++g)
+    if (g != self && anyHit(hit, s.group_begin[g], s.group_begin[g + 1])) mask[g >> 6] |= std::uint64_t(1) << (g & 63);
+}
+
+/// Pass 1, cell by cell: each cell's neighbourhood is grouped by observation
+/// once and shared by all the points of the cell, whatever their observation.
+CellMatches matchCells(const Grid& grid, double delta, int threads, const ProgressCallback& progress,
+                       std::size_t progress_total, const InterruptFlag* interrupt) {
+  const std::size_t cells = grid.cells();
+  CellMatches out;
+  out.near_offsets.assign(cells + 1, 0);
+  out.mask_offsets.assign(cells + 1, 0);
+  for (std::size_t c = 0; c < cells; ++c) {
+    const std::uint64_t near = grid.observationsNear(c), points = grid.pointsOfCell(c);
+    out.near_offsets[c + 1] = out.near_offsets[c] + near;
+    out.mask_offsets[c + 1] = out.mask_offsets[c] + points * ((near + 63) / 64);
+    out.point_tests += (near - 1) * points;  // each point against every observation near it but its own
+  }
+  out.near.resize(out.near_offsets[cells]);
+  out.masks.assign(out.mask_offsets[cells], 0);
+  const MatchDistance within(delta);
+  const float inside = float(delta * delta * (1.0 - 1e-4)), outside = float(delta * delta * (1.0 + 1e-4));
+  const std::vector<Run>& runs = grid.runs();
+  std::atomic<std::size_t> done{0};
+#pragma omp parallel num_threads(threads)
+  {
+    NeighbourhoodScratch scratch(grid.observations());
+    bool stopped = false;  // no throwing inside the parallel region
+#pragma omp for schedule(dynamic, 256)
+    for (std::size_t c = 0; c < cells; ++c) {
+      if (c % 256 == 0) {
+        stopped = stopped || interruptRequested(interrupt);
+        const std::size_t now = done += 256;
+        if (progress && omp_get_thread_num() == 0) progress(std::min(now, cells), progress_total);
+      }
+      if (stopped) continue;
+      const std::uint32_t groups = groupNeighbourhood(grid, c, out.near.data() + out.near_offsets[c], scratch);
+      const std::size_t words = out.words(c);
+      std::uint64_t* mask = out.masks.data() + out.mask_offsets[c];
+      const Span own = grid.runsOfCell(c);
+      for (std::uint32_t r = own.begin; r < own.end; ++r) {
+        const std::uint32_t self = scratch.group[runs[r].observation];
+        for (std::uint32_t k = runs[r].begin; k < runs[r].end; ++k, mask += words)
+          matchPoint(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
+      }
+    }
+  }
+  return out;
+}
 
 /// Per-thread scratch for one row of counts: dense by observation, reset only
 /// where touched, so a row costs O(matches), not O(N).
 struct RowScratch {
-  explicit RowScratch(int n) : seen(n, 0), tested(n, -1), count(n, 0) {}
-  std::vector<std::uint32_t> seen;  // point stamp of the last match with j
-  std::vector<int> tested;          // last row i that compared points with j
+  explicit RowScratch(int n) : tested(n, -1), count(n, 0), touched(n) {}
+  std::vector<int> tested;  // last row i that compared points with j
   std::vector<std::uint32_t> count;
   std::vector<int> touched;
-  std::uint32_t stamp = 0;
-  std::uint64_t pairs = 0, tests = 0;
-
-  void nextPoint() {
-    if (++stamp == 0) {  // wrapped: forget old stamps
-      std::fill(seen.begin(), seen.end(), 0);
-      stamp = 1;
-    }
-  }
+  std::uint64_t pairs = 0;
 };
 
-void countRow(const Grid& grid, const WorldPoints& world, int i, const MatchDistance& within, RowScratch& s,
-              std::vector<MatchCount>& row) {
-  // Visit i's points cell by cell, so each neighbourhood is looked up once per cell.
-  const std::size_t m = world.count(i);
-  std::vector<std::pair<CellKey, std::uint32_t>> cells(m);
-  for (std::size_t k = 0; k < m; ++k) cells[k] = {grid.cellOf(world.begin(i)[k]), static_cast<std::uint32_t>(k)};
-  std::sort(cells.begin(), cells.end(), [](const auto& a, const auto& b) {
-    return a.first == b.first ? a.second < b.second : a.first < b.first;
-  });
-  std::array<CellRuns, 27> neighbourhood;
-  for (std::size_t first = 0; first < m;) {
-    const CellKey c = cells[first].first;
-    int used = 0;
-    grid.forEachNeighbour(c, [&](const CellRuns& runs) { neighbourhood[used++] = runs; });
-    std::size_t last = first;
-    while (last < m && cells[last].first == c) ++last;
-    // Each point is tested once against every other observation near its cell.
-    s.tests += std::uint64_t(grid.observationsNear(grid.table().find(c).ordinal) - 1) * (last - first);
-    for (std::size_t k = first; k < last; ++k) {
-      const Eigen::Vector3f& p = world.begin(i)[cells[k].second];
-      s.nextPoint();
-      for (int h = 0; h < used; ++h) {
-        for (std::uint32_t r = neighbourhood[h].begin; r < neighbourhood[h].end; ++r) {
-          const Run& run = grid.runs()[r];
-          const int j = run.observation;
-          if (j == i || s.seen[j] == s.stamp) continue;  // each j counted once per point
-          if (s.tested[j] != i) {
-            s.tested[j] = i;
-            ++s.pairs;
-          }
-          for (std::uint32_t q = run.begin; q < run.end; ++q) {
-            if (within(p, grid.points()[q])) {
-              s.seen[j] = s.stamp;
-              if (s.count[j]++ == 0) s.touched.push_back(j);
-              break;
-            }
-          }
-        }
-      }
+/// Pass 2, observation by observation: adds up the bit sets of i's points.
+void countRow(const Grid& grid, const CellMatches& matches, int i, RowScratch& s, std::vector<MatchCount>& row) {
+  int* tested = s.tested.data();
+  std::uint32_t* count = s.count.data();
+  int* touched = s.touched.data();
+  std::size_t touched_size = 0;
+  tested[i] = i;  // never a pair of itself
+  const Span mine = grid.runsOf(i);
+  for (std::uint32_t k = mine.begin; k < mine.end; ++k) {
+    const std::uint32_t run = grid.observationRun(k);
+    const std::uint32_t cell = grid.cellOfRun(run);
+    const std::int32_t* near = matches.near.data() + matches.near_offsets[cell];
+    const std::size_t near_size = matches.near_offsets[cell + 1] - matches.near_offsets[cell];
+    for (std::size_t g = 0; g < near_size; ++g) {  // every j near the cell had points compared with i's
+      s.pairs += tested[near[g]] != i;
+      tested[near[g]] = i;
     }
-    first = last;
+    const std::size_t words = matches.words(cell);
+    const Run& points = grid.runs()[run];
+    const std::uint64_t* mask = matches.masks.data() + matches.mask_offsets[cell] +
+                                std::size_t(points.begin - grid.firstPointOfCell(cell)) * words;
+    for (std::uint32_t p = points.begin; p < points.end; ++p)
+      for (std::size_t w = 0; w < words; ++w, ++mask)
+        for (std::uint64_t bits = *mask; bits != 0; bits &= bits - 1) {
+          const int j = near[w * 64 + static_cast<std::size_t>(__builtin_ctzll(bits))];
+          touched[touched_size] = j;
+          touched_size += count[j]++ == 0;
+        }
   }
-  std::sort(s.touched.begin(), s.touched.end());
-  row.reserve(s.touched.size());
-  for (int j : s.touched) {
-    row.push_back({j, s.count[j]});
-    s.count[j] = 0;
+  std::sort(touched, touched + touched_size);
+  row.reserve(touched_size);
+  for (std::size_t t = 0; t < touched_size; ++t) {
+    row.push_back({touched[t], count[touched[t]]});
+    count[touched[t]] = 0;
   }
-  s.touched.clear();
 }
 
 }  // namespace
@@ -285,30 +452,31 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   MatchCounts out;
   out.rows.resize(n);
   if (n == 0) return out;
-  const Grid grid(world, delta);
-  const MatchDistance within(delta);
   const int nthreads = threads > 0 ? threads : omp_get_max_threads();
-  std::uint64_t pairs = 0, tests = 0;
+  // Every point's cell is computed (and range-checked) when the grid is
+  // built, so nothing below can throw inside a parallel region.
+  const Grid grid(world, delta, nthreads);
+  const std::size_t progress_total = grid.cells() + std::size_t(n);
+  const CellMatches matches = matchCells(grid, delta, nthreads, progress, progress_total, interrupt);
+  throwIfInterrupted(interrupt);
+  std::uint64_t pairs = 0;
   std::atomic<std::size_t> done{0};
-  // Every point's cell was computed (and range-checked) when the grid was
-  // built, so nothing below can throw inside the parallel region.
-#pragma omp parallel num_threads(nthreads) reduction(+ : pairs, tests)
+#pragma omp parallel num_threads(nthreads) reduction(+ : pairs)
   {
     RowScratch scratch(n);
-#pragma omp for schedule(dynamic, 8)
+#pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
-      if (interruptRequested(interrupt)) continue;  // no throwing inside the parallel region
-      countRow(grid, world, i, within, scratch, out.rows[i]);
+      if (interruptRequested(interrupt)) continue;
+      countRow(grid, matches, i, scratch, out.rows[i]);
       const std::size_t now = ++done;
-      if (progress && omp_get_thread_num() == 0) progress(now, n);
+      if (progress && omp_get_thread_num() == 0) progress(grid.cells() + now, progress_total);
     }
     pairs += scratch.pairs;
-    tests += scratch.tests;
   }
   throwIfInterrupted(interrupt);
-  if (progress) progress(n, n);
+  if (progress) progress(progress_total, progress_total);
   out.pairs_evaluated = pairs;
-  out.point_tests = tests;
+  out.point_tests = matches.point_tests;
   return out;
 }
 

@@ -14,11 +14,14 @@ namespace obsgroup {
 ///
 /// The grid's cells are a hair larger than delta, so two points within delta
 /// always fall in the same or adjacent cells whatever the rounding of the
-/// cell index; the match itself is decided by MatchDistance. Each
-/// point is tested against the 3x3 (flat data) or 3x3x3 neighbouring cells,
-/// and each nearby observation is counted at most once per point. Rows are
-/// independent, so the result is the same for any number of threads.
-/// Throws Interrupted when `interrupt` is set during the pass.
+/// cell index; the match itself is decided by MatchDistance. Two passes:
+/// cell by cell, the 3x3 (flat data) or 3x3x3 neighbourhood is grouped by
+/// observation once and every point of the cell, whatever its observation, is
+/// tested against each other observation of it, giving one bit per (point,
+/// nearby observation); then observation by observation, the bits of its
+/// points are added up. Integer counts in fixed places: the result is the
+/// same for any number of threads. Progress is reported in cells and then
+/// observations done. Throws Interrupted when `interrupt` is set.
 MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0,
                                    const ProgressCallback& progress = {},
                                    const InterruptFlag* interrupt = nullptr);
