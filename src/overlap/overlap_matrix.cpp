@@ -15,27 +15,39 @@ OverlapResult assembleOverlap(const MatchCounts& counts, const WorldPoints& worl
   out.points_per_observation.resize(n);
   for (int i = 0; i < n; ++i) out.points_per_observation[i] = world.count(i);
 
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int i = 0; i < n; ++i)
-    for (const MatchCount& m : counts.rows[i])
-      triplets.emplace_back(i, m.j, double(m.count) / double(world.count(i)));  // eq. (17)
+  // Pi row by row, eq. (17): the rows arrive sorted by j, so the compressed
+  // storage is filled directly.
+  using RowMatrix = decltype(out.match_ratio);
   out.match_ratio.resize(n, n);
-  out.match_ratio.setFromTriplets(triplets.begin(), triplets.end());
-
-  // Psi = (Pi_ij + Pi_ji) / 2, eq. (18). Taking Pi_ji from the matrix (and 0
-  // when absent) keeps this exact whatever the order counts arrived in.
+  std::size_t entries = 0;
+  for (const auto& row : counts.rows) entries += row.size();
+  out.match_ratio.reserve(static_cast<Eigen::Index>(entries));
   for (int i = 0; i < n; ++i) {
-    for (decltype(out.match_ratio)::InnerIterator it(out.match_ratio, i); it; ++it) {
-      const int j = static_cast<int>(it.col());
-      const double pi_ji = out.match_ratio.coeff(j, i);
-      if (j > i || pi_ji == 0.0) {
-        const int a = std::min(i, j), b = std::max(i, j);
-        out.pairs.push_back({a, b, 0.5 * (out.match_ratio.coeff(a, b) + out.match_ratio.coeff(b, a))});
-      }
+    out.match_ratio.startVec(i);
+    int previous = -1;
+    for (const MatchCount& m : counts.rows[i]) {
+      if (m.j <= previous || m.j >= n || m.j == i || m.count == 0)
+        throw std::invalid_argument("assembleOverlap: each row must list distinct j != i, ascending, with count > 0");
+      previous = m.j;
+      out.match_ratio.insertBack(i, m.j) = double(m.count) / double(world.count(i));
     }
   }
-  std::sort(out.pairs.begin(), out.pairs.end(),
-            [](const WeightedPair& x, const WeightedPair& y) { return x.i < y.i || (x.i == y.i && x.j < y.j); });
+  out.match_ratio.finalize();
+
+  // Psi = (Pi_ij + Pi_ji) / 2, eq. (18), for every pair with either ratio
+  // non-zero: row i of Pi merged with row i of its transpose (Pi_ji).
+  const RowMatrix transposed = out.match_ratio.transpose();
+  for (int i = 0; i < n; ++i) {
+    RowMatrix::InnerIterator ij(out.match_ratio, i), ji(transposed, i);
+    while (ij || ji) {
+      const int j = std::min(ij ? int(ij.col()) : n, ji ? int(ji.col()) : n);
+      const double pi_ij = ij && ij.col() == j ? ij.value() : 0.0;
+      const double pi_ji = ji && ji.col() == j ? ji.value() : 0.0;
+      if (j > i) out.pairs.push_back({i, j, 0.5 * (pi_ij + pi_ji)});
+      if (ij && ij.col() == j) ++ij;
+      if (ji && ji.col() == j) ++ji;
+    }
+  }
   return out;
 }
 
