@@ -46,15 +46,25 @@ Eigen::VectorXd degrees(const WeightMatrix& W) {
 
 WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members, std::vector<int>& local_of) {
   const int m = static_cast<int>(members.size());
+  for (int k = 1; k < m; ++k)
+    if (members[k] <= members[k - 1])
+      throw std::invalid_argument("inducedSubgraph: members must be sorted ascending and unique");
   for (int k = 0; k < m; ++k) local_of[members[k]] = k;
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int local_col = 0; local_col < m; ++local_col)
-    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it)
-      if (local_of[it.row()] >= 0) triplets.emplace_back(local_of[it.row()], local_col, it.value());
-  for (int i : members) local_of[i] = -1;
+  // Members ascend, so local indices ascend with W's row indices: each column
+  // is filled in order, straight into compressed storage.
   WeightMatrix sub(m, m);
-  sub.setFromTriplets(triplets.begin(), triplets.end());
-  sub.makeCompressed();
+  std::size_t entries = 0;
+  for (int i : members)
+    entries += static_cast<std::size_t>(W.isCompressed() ? W.outerIndexPtr()[i + 1] - W.outerIndexPtr()[i]
+                                                         : W.innerNonZeroPtr()[i]);
+  sub.reserve(static_cast<Eigen::Index>(entries));
+  for (int local_col = 0; local_col < m; ++local_col) {
+    sub.startVec(local_col);
+    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it)
+      if (local_of[it.row()] >= 0) sub.insertBack(local_of[it.row()], local_col) = it.value();
+  }
+  sub.finalize();
+  for (int i : members) local_of[i] = -1;
   return sub;
 }
 

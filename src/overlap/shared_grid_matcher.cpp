@@ -44,23 +44,46 @@ struct Entry {
 
 /// Stable LSD radix sort by cell key (x, then y, then z), 11 bits per pass
 /// and only as many passes as the extent of the map needs; entries that share
-/// a cell keep their input order. O(n), and the same for any thread count.
-void sortByCell(std::vector<Entry>& entries) {
-  std::vector<Entry> buffer(entries.size());
+/// a cell keep their input order. Each pass splits the entries into one slice
+/// per thread, and slice t's entries of a digit land after those of slices
+/// before t: the order is the same for any thread count.
+void sortByCell(std::vector<Entry>& entries, int threads) {
+  constexpr std::uint32_t kDigits = 2048;
+  const std::size_t n = entries.size();
+  if (n == 0) return;
+  std::vector<Entry> buffer(n);
   const auto coordinate = [](const Entry& e, int axis) { return axis == 0 ? e.key.x : axis == 1 ? e.key.y : e.key.z; };
+  const int slices = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(threads, n / 65536 + 1)));
+  std::vector<std::size_t> bounds(slices + 1);
+  for (int t = 0; t <= slices; ++t) bounds[t] = n * std::size_t(t) / std::size_t(slices);
+  std::vector<std::size_t> start(std::size_t(slices) * kDigits);
   for (int axis = 2; axis >= 0; --axis) {  // least significant key first
     std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = std::numeric_limits<std::int32_t>::min();
-    for (const Entry& e : entries) {
-      lo = std::min(lo, coordinate(e, axis));
-      hi = std::max(hi, coordinate(e, axis));
+#pragma omp parallel for num_threads(slices) reduction(min : lo) reduction(max : hi)
+    for (std::size_t k = 0; k < n; ++k) {
+      lo = std::min(lo, coordinate(entries[k], axis));
+      hi = std::max(hi, coordinate(entries[k], axis));
     }
-    const std::uint32_t extent = entries.empty() ? 0 : std::uint32_t(std::int64_t(hi) - lo);
+    const std::uint32_t extent = std::uint32_t(std::int64_t(hi) - lo);
     for (int shift = 0; shift < 32 && (extent >> shift) != 0; shift += 11) {
-      const auto digit = [&](const Entry& e) { return (std::uint32_t(std::int64_t(coordinate(e, axis)) - lo) >> shift) & 2047u; };
-      std::array<std::size_t, 2049> start{};
-      for (const Entry& e : entries) ++start[digit(e) + 1];
-      for (std::size_t d = 0; d < 2048; ++d) start[d + 1] += start[d];
-      for (const Entry& e : entries) buffer[start[digit(e)]++] = e;
+      const auto digit = [&](const Entry& e) {
+        return (std::uint32_t(std::int64_t(coordinate(e, axis)) - lo) >> shift) & (kDigits - 1);
+      };
+      std::fill(start.begin(), start.end(), 0);
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+      for (int t = 0; t < slices; ++t)
+        for (std::size_t k = bounds[t]; k < bounds[t + 1]; ++k) ++start[std::size_t(t) * kDigits + digit(entries[k])];
+      std::size_t at = 0;
+      for (std::uint32_t d = 0; d < kDigits; ++d)
+        for (int t = 0; t < slices; ++t) {
+          const std::size_t count = start[std::size_t(t) * kDigits + d];
+          start[std::size_t(t) * kDigits + d] = at;
+          at += count;
+        }
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+      for (int t = 0; t < slices; ++t)
+        for (std::size_t k = bounds[t]; k < bounds[t + 1]; ++k)
+          buffer[start[std::size_t(t) * kDigits + digit(entries[k])]++] = entries[k];
       entries.swap(buffer);
     }
   }
@@ -83,6 +106,8 @@ class Grid {
 
   std::size_t cells() const { return cell_runs_.size(); }
   int columns() const { return columns_; }
+  /// Every point has the same z (2D scans): distances need no z.
+  bool planar() const { return planar_; }
   /// The run slices of a cell's neighbourhood (columns() of them).
   const Span* neighbourhood(std::size_t cell) const { return &neighbourhood_[cell * columns_]; }
   /// Distinct observations with points in the neighbourhood of a cell.
@@ -140,18 +165,27 @@ class Grid {
 
   void build() {
     std::vector<Entry> entries = cellEntries();
-    sortByCell(entries);
+    sortByCell(entries, threads_);
     const std::size_t total = entries.size();
     flat_ = std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.key.z == entries[0].key.z; });
     columns_ = flat_ ? 3 : 9;
+    // The gathers are random reads: done in parallel, then the runs are cut
+    // in one sequential sweep.
     std::vector<std::int32_t> observation_of(total);
+#pragma omp parallel for num_threads(threads_) schedule(dynamic, 64)
     for (int i = 0; i < world_.size(); ++i)
       std::fill(observation_of.begin() + world_.offsets[i], observation_of.begin() + world_.offsets[i + 1], i);
     points_.resize(total);
-    std::vector<CellKey> keys;
+    std::vector<std::int32_t> grid_observation(total);
+#pragma omp parallel for num_threads(threads_) schedule(static, 65536)
     for (std::size_t k = 0; k < total; ++k) {
       points_[k] = world_.points[entries[k].index];
-      const std::int32_t observation = observation_of[entries[k].index];
+      grid_observation[k] = observation_of[entries[k].index];
+    }
+    observation_of = {};
+    std::vector<CellKey> keys;
+    for (std::size_t k = 0; k < total; ++k) {
+      const std::int32_t observation = grid_observation[k];
       const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
       if (new_cell) {
         keys.push_back(entries[k].key);
@@ -165,6 +199,7 @@ class Grid {
       cell_runs_.back().end = static_cast<std::uint32_t>(runs_.size());
     }
     entries = {};
+    planar_ = std::all_of(points_.begin(), points_.end(), [&](const Eigen::Vector3f& p) { return p.z() == points_[0].z(); });
     indexRunsByObservation();
     buildNeighbourhoods(keys);
     countObservationsNear();
@@ -228,7 +263,7 @@ class Grid {
   const WorldPoints& world_;
   int threads_;
   double inv_cell_ = 0.0;
-  bool flat_ = true;
+  bool flat_ = true, planar_ = true;
   int columns_ = 3;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Run> runs_;
@@ -255,35 +290,49 @@ struct CellMatches {
 
 /// The float test of MatchDistance, written so that the compiler vectorises
 /// it; `border` tells whether some distance fell in the band where only the
-/// double test may decide.
+/// double test may decide. Planar data (every z the same) skips z.
+template <bool Planar>
 std::uint8_t floatMatches(const Eigen::Vector3f& p, float inside, float outside, const float* __restrict x,
                           const float* __restrict y, const float* __restrict z, std::uint8_t* __restrict hit,
                           std::uint32_t begin, std::uint32_t end) {
   const float px = p.x(), py = p.y(), pz = p.z();
   std::uint8_t border = 0;
   for (std::uint32_t q = begin; q < end; ++q) {
-    const float dx = px - x[q], dy = py - y[q], dz = pz - z[q];
-    const float d = dx * dx + dy * dy + dz * dz;
+    const float dx = px - x[q], dy = py - y[q];
+    float d = dx * dx + dy * dy;
+    if (!Planar) {
+      const float dz = pz - z[q];
+      d += dz * dz;
+    }
     hit[q] = d < inside;
     border |= (d >= inside) & (d <= outside);
   }
   return border;
 }
 
+/// keep[n]: a word whose first n bytes in memory are 0xff and the rest 0,
+/// whatever the endianness.
+struct ByteMasks {
+  std::uint64_t keep[9];
+  ByteMasks() {
+    for (int n = 0; n <= 8; ++n) {
+      std::uint8_t bytes[8] = {};
+      std::memset(bytes, 0xff, n);
+      std::memcpy(&keep[n], bytes, 8);
+    }
+  }
+};
+const ByteMasks kByteMasks;
+
 /// Whether any of hit[begin, end) is set; hit is readable 8 bytes past end.
-bool anyHit(const std::uint8_t* hit, std::uint32_t begin, std::uint32_t end) {
-  static constexpr std::uint8_t kTail[16] = {255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 0, 0, 0, 0, 0};
-  std::uint64_t any = 0, word, keep;
+inline bool anyHit(const std::uint8_t* hit, std::uint32_t begin, std::uint32_t end) {
+  std::uint64_t any = 0, word;
   for (; begin + 8 <= end; begin += 8) {
     std::memcpy(&word, hit + begin, 8);
     any |= word;
   }
-  if (begin < end) {
-    std::memcpy(&word, hit + begin, 8);
-    std::memcpy(&keep, kTail + 8 - (end - begin), 8);  // the first end - begin bytes, whatever the endianness
-    any |= word & keep;
-  }
-  return any != 0;
+  std::memcpy(&word, hit + begin, 8);
+  return (any | (word & kByteMasks.keep[end - begin])) != 0;
 }
 
 /// Per-thread scratch of the cell pass: the neighbourhood's points grouped by
@@ -335,18 +384,34 @@ std::uint32_t groupNeighbourhood(const Grid& grid, std::size_t c, std::int32_t* 
 
 /// Sets, in `mask`, the groups of the neighbourhood that have a point within
 /// delta of p, its own group `self` excepted.
+template <bool Planar>
 void matchPoint(const Eigen::Vector3f& p, std::uint32_t self, std::uint32_t groups, const MatchDistance& within,
                 float inside, float outside, NeighbourhoodScratch& s, std::uint64_t* mask) {
   const std::uint32_t total = s.group_begin[groups];
   const std::uint32_t own_begin = s.group_begin[self], own_end = s.group_begin[self + 1];
   std::uint8_t* hit = s.hit.data();
-  std::uint8_t border = floatMatches(p, inside, outside, s.x.data(), s.y.data(), s.z.data(), hit, 0, own_begin);
-  border |= floatMatches(p, inside, outside, s.x.data(), s.y.data(), s.z.data(), hit, own_end, total);
-  if (border) {  // rare: a distance within 1e-4 of delta, decided in double
-    for (std::uint32_t q = 0; q < total; ++q) hit[q] = within(p, Eigen::Vector3f(s.x[q], s.y[q], s.z[q]));
+  const float *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
+  std::uint8_t border;
+  if (own_end - own_begin <= 16) {  // one loop is cheaper than skipping a few points
+    border = floatMatches<Planar>(p, inside, outside, x, y, z, hit, 0, total);
+  } else {  // dense clouds: most of the neighbourhood is the point's own observation
+    border = floatMatches<Planar>(p, inside, outside, x, y, z, hit, 0, own_begin);
+    border |= floatMatches<Planar>(p, inside, outside, x, y, z, hit, own_end, total);
   }
-  for (std::uint32_t g = 0; g < groups; ++g)
-    if (g != self && anyHit(hit, s.group_begin[g], s.group_begin[g + 1])) mask[g >> 6] |= std::uint64_t(1) << (g & 63);
+  if (border) {  // rare: a distance within 1e-4 of delta, decided in double
+    for (std::uint32_t q = 0; q < total; ++q) hit[q] = within(p, Eigen::Vector3f(x[q], y[q], z[q]));
+  }
+  // Branch-free: whether a group matched is as good as a coin flip.
+  std::uint64_t word = 0;
+  for (std::uint32_t g = 0; g < groups; ++g) {
+    word |= std::uint64_t(anyHit(hit, s.group_begin[g], s.group_begin[g + 1])) << (g & 63);
+    if ((g & 63) == 63) {
+      mask[g >> 6] = word;
+      word = 0;
+    }
+  }
+  if (groups & 63) mask[groups >> 6] = word;
+  mask[self >> 6] &= ~(std::uint64_t(1) << (self & 63));
 }
 
 /// Pass 1, cell by cell: each cell's neighbourhood is grouped by observation
@@ -388,7 +453,10 @@ CellMatches matchCells(const Grid& grid, double delta, int threads, const Progre
       for (std::uint32_t r = own.begin; r < own.end; ++r) {
         const std::uint32_t self = scratch.group[runs[r].observation];
         for (std::uint32_t k = runs[r].begin; k < runs[r].end; ++k, mask += words)
-          matchPoint(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
+          if (grid.planar())
+            matchPoint<true>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
+          else
+            matchPoint<false>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
       }
     }
   }
