@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include <omp.h>
+
 namespace obsgroup {
 
 void WorldPoints::append(const std::vector<Eigen::Vector3f>& observation_points) {
@@ -11,6 +13,23 @@ void WorldPoints::append(const std::vector<Eigen::Vector3f>& observation_points)
   points.insert(points.end(), observation_points.begin(), observation_points.end());
   offsets.push_back(points.size());
   boxes.push_back(box);
+}
+
+void WorldPoints::appendAll(const std::vector<std::vector<Eigen::Vector3f>>& per_observation, int threads) {
+  const std::size_t first = boxes.size();
+  const int n = static_cast<int>(per_observation.size());
+  for (const auto& observation_points : per_observation)
+    offsets.push_back(offsets.back() + observation_points.size());
+  points.resize(offsets.back());
+  boxes.resize(first + per_observation.size());
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 16)
+  for (int i = 0; i < n; ++i) {
+    const auto& observation_points = per_observation[i];
+    Eigen::AlignedBox3f box;  // default-constructed: empty
+    for (const auto& p : observation_points) box.extend(p);
+    boxes[first + i] = box;
+    std::copy(observation_points.begin(), observation_points.end(), points.begin() + offsets[first + i]);
+  }
 }
 
 std::vector<std::vector<int>> overlappingBoxes(const WorldPoints& world, double delta) {

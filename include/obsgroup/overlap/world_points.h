@@ -30,6 +30,9 @@ struct WorldPoints {
 
   /// Appends one observation; its box is computed from the points.
   void append(const std::vector<Eigen::Vector3f>& observation_points);
+  /// Appends many observations at once, copying in parallel (threads <= 0:
+  /// all); the result is the same as appending them one by one.
+  void appendAll(const std::vector<std::vector<Eigen::Vector3f>>& per_observation, int threads = 0);
 };
 
 /// For each observation j, the observations i != j (ascending) whose bounding

@@ -84,10 +84,7 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
   }
   for (int i = 0; i < n; ++i)
     if (!errors[i].empty()) throw InvalidObservation(i, errors[i]);
-  for (auto& points : per_observation) {
-    world.append(points);
-    std::vector<Eigen::Vector3f>().swap(points);
-  }
+  world.appendAll(per_observation, threads);
   return world;
 }
 
