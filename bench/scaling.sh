@@ -8,7 +8,9 @@
 #
 #   bench/scaling.sh [--quick] [--output docs/performance.md]
 #
-# --quick runs 1k and 10k only. Needs /usr/bin/time (Debian package `time`).
+# --quick runs 1k and 10k only. Each obsgroup case runs OBSGROUP_BENCH_RUNS
+# times (default 3) and the median run is reported; MRPT runs once.
+# Needs /usr/bin/time (Debian package `time`).
 # Inputs are generated under ${OBSGROUP_BENCH_DIR:-/tmp/obsgroup-bench} and reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,22 +29,36 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DOBSGROUP_BUILD_BENCHMARKS=ON > 
 cmake --build build -j"$(nproc)" --target obsgroup_cli make_scaling_input > /dev/null
 exe=build/obsgroup
 
-# Runs obsgroup on one input; prints one table row.
+runs=${OBSGROUP_BENCH_RUNS:-3}
+
+# Runs obsgroup $runs times on one input; prints one table row: the run with
+# the median wall time, and the range of wall times over the runs.
 run() {  # name input extra-options...
   local name=$1 input=$2; shift 2
   local out=$work/out_$name
-  /usr/bin/time -v -o "$work/time_$name" "$exe" partition "$input" -o "$out" --force -q --no-pictures "$@"
-  python3 - "$out/partition.json" "$work/time_$name" "$name" <<'PY'
+  for r in $(seq "$runs"); do
+    /usr/bin/time -v -o "$work/time_${name}_$r" "$exe" partition "$input" -o "$out" --force -q --no-pictures "$@"
+    cp "$out/partition.json" "$work/partition_${name}_$r.json"
+  done
+  python3 - "$work" "$name" "$runs" <<'PY'
 import json, re, sys
-p = json.load(open(sys.argv[1])); t = p["timing_s"]; s = p["statistics"]
-log = open(sys.argv[2]).read()
-wall = re.search(r"Elapsed \(wall clock\) time.*: (.*)", log).group(1).split(":")
-wall = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
-rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", log).group(1)) / 1024
+work, name, runs = sys.argv[1], sys.argv[2], int(sys.argv[3])
+rows = []
+for r in range(1, runs + 1):
+    p = json.load(open(f"{work}/partition_{name}_{r}.json"))
+    log = open(f"{work}/time_{name}_{r}").read()
+    wall = re.search(r"Elapsed \(wall clock\) time.*: (.*)", log).group(1).split(":")
+    wall = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
+    rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", log).group(1)) / 1024
+    rows.append((wall, rss, p))
+rows.sort(key=lambda row: row[0])
+wall, rss, p = rows[len(rows) // 2]
+t, s = p["timing_s"], p["statistics"]
 rate = s["point_tests"] / t["overlap"] / 1e6 if t["overlap"] > 0 else 0
-print(f"| {sys.argv[3]} | {p['observations']:,} | {s['points']:,} | {s['pairs_evaluated']:,} | {rate:.0f} | "
+spread = f" ({rows[0][0]:.2f}-{rows[-1][0]:.2f})" if runs > 1 else ""
+print(f"| {name} | {p['observations']:,} | {s['points']:,} | {s['pairs_evaluated']:,} | {rate:.0f} | "
       f"{t['load']:.2f} | {t['overlap']:.2f} | {t['partition']:.2f} | {t['local_maps'] + t['outputs']:.2f} | "
-      f"{wall:.2f} | {rss:.0f} | {s['groups']:,} |")
+      f"{wall:.2f}{spread} | {max(row[1] for row in rows):.0f} | {s['groups']:,} |")
 PY
 }
 
@@ -51,7 +67,7 @@ sizes="1000 10000 100000"
 {
   echo "Machine: $(nproc) cores, $(awk '/MemTotal/{printf "%.0f GiB", $2/1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'); $(date -u +%Y-%m-%d)."
   echo
-  echo "| input | N | points | pairs evaluated | overlap M tests/s | load s | overlap s | partition s | maps+outputs s | wall s | peak RSS MB | groups |"
+  echo "| input | N | points | pairs evaluated | overlap M tests/s | load s | overlap s | partition s | maps+outputs s | wall s, median (range) | peak RSS MB, max | groups |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
   for n in $sizes; do
     [ -f "$work/building_$n.clf" ] || build/bench/make_scaling_input 2d "$n" "$work/building_$n.clf" > /dev/null
@@ -65,13 +81,15 @@ sizes="1000 10000 100000"
     echo
     echo "Side by side with MRPT's map-partition class on the same inputs, MRPT's settings (delta 0.2 m, Ncut threshold 0.9):"
     echo
-    echo "| input | N | obsgroup wall s | obsgroup groups | MRPT wall s | MRPT groups | MRPT / obsgroup |"
+    echo "| input | N | obsgroup wall s (median of $runs) | obsgroup groups | MRPT wall s | MRPT groups | MRPT / obsgroup |"
     echo "|---|---|---|---|---|---|---|"
     for name in tile_sep_0600 tile_ovl_0300 tile_sep_1200 tile_sep_2400 tile_ovl_2400; do
       dir=$shared/data/scaling/$name
-      /usr/bin/time -v -o "$work/time_$name" "$exe" partition "$dir/$name.clf" -o "$work/out_$name" --force -q \
-        --no-pictures --delta 0.2 --ncut-threshold 0.9
-      ours=$(awk -F': ' '/Elapsed \(wall clock\)/{n=split($2,t,":"); s=0; for(i=1;i<=n;i++) s=s*60+t[i]; print s}' "$work/time_$name")
+      ours=$(for r in $(seq "$runs"); do
+        /usr/bin/time -v -o "$work/time_$name" "$exe" partition "$dir/$name.clf" -o "$work/out_$name" --force -q \
+          --no-pictures --delta 0.2 --ncut-threshold 0.9
+        awk -F': ' '/Elapsed \(wall clock\)/{n=split($2,t,":"); s=0; for(i=1;i<=n;i++) s=s*60+t[i]; print s}' "$work/time_$name"
+      done | sort -n | awk '{v[NR]=$1} END{print v[int((NR+1)/2)]}')
       groups=$(python3 -c "import json;print(len(json.load(open('$work/out_$name/partition.json'))['groups']))")
       # MRPT at 2400 scans runs for many minutes (peer/mrpt/README.md: not finished after 319 s):
       # it is stopped at 120 s here, and the ratio is then a lower bound.
