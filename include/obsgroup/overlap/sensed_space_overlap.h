@@ -17,7 +17,7 @@ namespace obsgroup {
 
 /// How the points of one observation find a point of another within delta.
 enum class NeighbourSearch {
-  SharedGrid,  ///< One spatial hash over all observations (the default, one pass).
+  SharedGrid,  ///< One grid over all observations' points (the default; see shared_grid_matcher.h).
   PclSearch    ///< One pcl::search::Search per observation (kd-tree by default).
 };
 

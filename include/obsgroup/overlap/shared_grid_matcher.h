@@ -1,8 +1,8 @@
 #pragma once
 /// \file
-/// The shared-grid neighbour back-end: one spatial hash over every
-/// observation's world points, so the whole overlap matrix comes from a
-/// single pass over the points.
+/// The shared-grid neighbour back-end: one grid over every
+/// observation's world points, so the whole overlap matrix comes from one
+/// pass over the cells and one over the observations.
 
 #include "obsgroup/interrupt.h"
 #include "obsgroup/overlap/overlap_matrix.h"
