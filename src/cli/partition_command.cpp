@@ -127,7 +127,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
 
   const auto outputs_start = Clock::now();
   io::OutputFolder out(args.output, args.force, args.interrupt);
-  const std::size_t map_points = io::writeLocalMaps(out, maps);
+  const std::size_t map_points = io::writeLocalMaps(out, maps, args.threads);
   out.writeText("topology.json", io::topologyJson(topology));
   out.writeText("topology.dot", io::topologyDot(topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(topology));

@@ -10,8 +10,9 @@
 
 namespace obsgroup::io {
 
-/// Writes one PCD per local map, in group order; returns the points written.
+/// Writes one PCD per local map, on `threads` threads (<= 0: all); returns
+/// the points written. A failure reports the lowest group that failed.
 template <typename PointT>
-std::size_t writeLocalMaps(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps);
+std::size_t writeLocalMaps(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0);
 
 }  // namespace obsgroup::io
