@@ -30,6 +30,14 @@ struct Run {
   std::uint32_t begin, end;  // into Grid::points
 };
 
+/// One observation's points in one cell, as pass 2 reads them: the cell, and
+/// where the points sit among the cell's points.
+struct OwnRun {
+  std::uint32_t cell;
+  std::uint32_t first;  ///< index of the run's first point among the cell's points
+  std::uint32_t count;
+};
+
 /// [begin, end) of some array.
 struct Span {
   std::uint32_t begin = 0, end = 0;
@@ -116,12 +124,9 @@ class Grid {
   std::uint32_t pointsOfCell(std::size_t cell) const {
     return runs_[cell_runs_[cell].end - 1].end - runs_[cell_runs_[cell].begin].begin;
   }
-  std::uint32_t firstPointOfCell(std::size_t cell) const { return runs_[cell_runs_[cell].begin].begin; }
   const std::vector<Run>& runs() const { return runs_; }
-  std::uint32_t cellOfRun(std::uint32_t run) const { return run_cell_[run]; }
-  /// The runs of observation i, in cell order.
-  Span runsOf(int i) const { return {observation_run_offsets_[i], observation_run_offsets_[i + 1]}; }
-  std::uint32_t observationRun(std::uint32_t k) const { return observation_runs_[k]; }
+  /// Observation i's runs, in cell order: [ownRuns(i), ownRuns(i + 1)).
+  const OwnRun* ownRuns(int i) const { return observation_runs_.data() + observation_run_offsets_[i]; }
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   int observations() const { return world_.size(); }
 
@@ -193,7 +198,6 @@ class Grid {
       }
       if (new_cell || observation != runs_.back().observation) {
         runs_.push_back(Run{observation, static_cast<std::uint32_t>(k), 0});
-        run_cell_.push_back(static_cast<std::uint32_t>(keys.size() - 1));
       }
       runs_.back().end = static_cast<std::uint32_t>(k + 1);
       cell_runs_.back().end = static_cast<std::uint32_t>(runs_.size());
@@ -213,7 +217,11 @@ class Grid {
     for (int i = 0; i < n; ++i) observation_run_offsets_[i + 1] += observation_run_offsets_[i];
     observation_runs_.resize(runs_.size());
     std::vector<std::uint32_t> next(observation_run_offsets_.begin(), observation_run_offsets_.end() - 1);
-    for (std::uint32_t r = 0; r < runs_.size(); ++r) observation_runs_[next[runs_[r].observation]++] = r;
+    for (std::uint32_t c = 0; c < cell_runs_.size(); ++c) {
+      const std::uint32_t first = runs_[cell_runs_[c].begin].begin;
+      for (std::uint32_t r = cell_runs_[c].begin; r < cell_runs_[c].end; ++r)
+        observation_runs_[next[runs_[r].observation]++] = {c, runs_[r].begin - first, runs_[r].end - runs_[r].begin};
+    }
   }
 
   /// One merge-like sweep over the sorted cells per column offset: as the
@@ -267,9 +275,9 @@ class Grid {
   int columns_ = 3;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Run> runs_;
-  std::vector<std::uint32_t> run_cell_;
   std::vector<Span> cell_runs_;
-  std::vector<std::uint32_t> observation_run_offsets_, observation_runs_;
+  std::vector<std::uint32_t> observation_run_offsets_;
+  std::vector<OwnRun> observation_runs_;
   std::vector<Span> neighbourhood_;
   std::vector<std::uint32_t> observations_near_;
 };
@@ -480,21 +488,21 @@ void countRow(const Grid& grid, const CellMatches& matches, int i, RowScratch& s
   int* touched = s.touched.data();
   std::size_t touched_size = 0;
   tested[i] = i;  // never a pair of itself
-  const Span mine = grid.runsOf(i);
-  for (std::uint32_t k = mine.begin; k < mine.end; ++k) {
-    const std::uint32_t run = grid.observationRun(k);
-    const std::uint32_t cell = grid.cellOfRun(run);
+  for (const OwnRun *own = grid.ownRuns(i), *end = grid.ownRuns(i + 1); own != end; ++own) {
+    if (own + 2 < end) {  // the cells of a row are scattered: fetch ahead
+      __builtin_prefetch(&matches.near_offsets[own[2].cell]);
+      __builtin_prefetch(&matches.mask_offsets[own[2].cell]);
+    }
+    const std::uint32_t cell = own->cell;
     const std::int32_t* near = matches.near.data() + matches.near_offsets[cell];
     const std::size_t near_size = matches.near_offsets[cell + 1] - matches.near_offsets[cell];
     for (std::size_t g = 0; g < near_size; ++g) {  // every j near the cell had points compared with i's
       s.pairs += tested[near[g]] != i;
       tested[near[g]] = i;
     }
-    const std::size_t words = matches.words(cell);
-    const Run& points = grid.runs()[run];
-    const std::uint64_t* mask = matches.masks.data() + matches.mask_offsets[cell] +
-                                std::size_t(points.begin - grid.firstPointOfCell(cell)) * words;
-    for (std::uint32_t p = points.begin; p < points.end; ++p)
+    const std::size_t words = (near_size + 63) / 64;
+    const std::uint64_t* mask = matches.masks.data() + matches.mask_offsets[cell] + std::size_t(own->first) * words;
+    for (std::uint32_t p = 0; p < own->count; ++p)
       for (std::size_t w = 0; w < words; ++w, ++mask)
         for (std::uint64_t bits = *mask; bits != 0; bits &= bits - 1) {
           const int j = near[w * 64 + static_cast<std::size_t>(__builtin_ctzll(bits))];
