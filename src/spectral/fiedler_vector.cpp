@@ -16,19 +16,34 @@ namespace {
 /// Normalized Laplacian of eq. (11): I - D^-1/2 W D^-1/2, written as
 /// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured.
 WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d) {
-  WeightMatrix L = -W;
-  L += WeightMatrix(Eigen::VectorXd(inv_sqrt_d.cwiseInverse().cwiseAbs2()).asDiagonal());
-  L = inv_sqrt_d.asDiagonal() * L * inv_sqrt_d.asDiagonal();
-  L.makeCompressed();
+  // D^-1/2 (D - W) D^-1/2 in one pass over W's columns, the diagonal entry
+  // inserted in row order. The arithmetic is that of the matrix expression
+  // (s_i * (d_i - w_ij)) * s_j, so results do not depend on how it is built.
+  const Eigen::Index n = W.outerSize();
+  const Eigen::VectorXd diagonal = inv_sqrt_d.cwiseInverse().cwiseAbs2();
+  WeightMatrix L(n, n);
+  L.reserve(W.nonZeros() + n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    L.startVec(j);
+    bool diagonal_done = false;
+    const auto put = [&](Eigen::Index i, double minus_w) {
+      const double x = i == j ? minus_w + diagonal[j] : minus_w;
+      L.insertBack(i, j) = (inv_sqrt_d[i] * x) * inv_sqrt_d[j];
+    };
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it) {
+      if (!diagonal_done && it.row() > j) {
+        put(j, 0.0);
+        diagonal_done = true;
+      }
+      if (it.row() == j) diagonal_done = true;
+      put(it.row(), -it.value());
+    }
+    if (!diagonal_done) put(j, 0.0);
+  }
+  L.finalize();
   return L;
 }
 
-/// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
-/// null vector of eq. (11)). Its largest eigenvalue is 1/lambda_1, so Lanczos
-/// converges at the rate lambda_1/lambda_2 with no shift to tune. L^+ is
-/// applied exactly by grounding: for b orthogonal to z0, L x = b has a solution
-/// with x_last = 0, found with a Cholesky factor of L without its last row and
-/// column (positive definite for a connected graph).
 class DeflatedLaplacianInverse {
  public:
   using Scalar = double;
