@@ -5,7 +5,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -41,7 +40,6 @@ struct OwnRun {
 /// [begin, end) of some array.
 struct Span {
   std::uint32_t begin = 0, end = 0;
-  std::uint32_t size() const { return end - begin; }
 };
 
 /// One world point and its cell, the unit the grid sorts.
