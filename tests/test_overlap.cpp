@@ -256,6 +256,23 @@ TEST(SensedSpaceOverlap, CrowdedDenseCloudsMatchTheBruteForceReference) {
   }
 }
 
+TEST(SensedSpaceOverlap, ProgressCountsObservationsAndEndsAtTheTotal) {
+  const auto obs = test::realLog(20);
+  for (auto method : kBackEnds) {
+    SensedSpaceOverlap<pcl::PointXYZ> sso;
+    sso.setNeighbourSearch(method);
+    std::vector<std::pair<std::size_t, std::size_t>> calls;
+    sso.setProgressCallback([&calls](std::size_t done, std::size_t total) { calls.emplace_back(done, total); });
+    sso.compute(obs);
+    ASSERT_FALSE(calls.empty());
+    for (const auto& [done, total] : calls) {
+      EXPECT_EQ(total, obs.size());
+      EXPECT_LE(done, total);
+    }
+    EXPECT_EQ(calls.back().first, obs.size());
+  }
+}
+
 TEST(SensedSpaceOverlap, FarFromTheOriginEqualsAtTheOrigin) {
   // UTM-sized coordinates: the same map shifted by (500 km, 4000 km).
   const auto plan = sim::threeRooms();

@@ -530,8 +530,14 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   // Every point's cell is computed (and range-checked) when the grid is
   // built, so nothing below can throw inside a parallel region.
   const Grid grid(world, delta, nthreads);
+  // Progress is reported in observations, as by the other back-end: the
+  // cells done and then the observations added up, scaled to n.
   const std::size_t progress_total = grid.cells() + std::size_t(n);
-  const CellMatches matches = matchCells(grid, delta, nthreads, progress, progress_total, interrupt);
+  const ProgressCallback in_observations = [&progress, progress_total, n](std::size_t done, std::size_t) {
+    progress(std::size_t(n) * std::min(done, progress_total) / progress_total, std::size_t(n));
+  };
+  const ProgressCallback report = progress ? in_observations : ProgressCallback{};
+  const CellMatches matches = matchCells(grid, delta, nthreads, report, progress_total, interrupt);
   throwIfInterrupted(interrupt);
   std::uint64_t pairs = 0;
   std::atomic<std::size_t> done{0};
@@ -543,12 +549,12 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
       if (interruptRequested(interrupt)) continue;
       countRow(grid, matches, i, scratch, out.rows[i]);
       const std::size_t now = ++done;
-      if (progress && omp_get_thread_num() == 0) progress(grid.cells() + now, progress_total);
+      if (report && omp_get_thread_num() == 0) report(grid.cells() + now, progress_total);
     }
     pairs += scratch.pairs;
   }
   throwIfInterrupted(interrupt);
-  if (progress) progress(progress_total, progress_total);
+  if (progress) progress(n, n);
   out.pairs_evaluated = pairs;
   out.point_tests = matches.point_tests;
   return out;

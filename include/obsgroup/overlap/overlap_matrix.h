@@ -18,9 +18,8 @@ struct MatchCount {
   std::uint32_t count = 0;
 };
 
-/// Progress of a long stage: called with the work done and the total work (in
-/// the stage's own units, e.g. observations), from one thread at a time, the
-/// last call with done == total.
+/// Progress of a long stage: called with the number of observations done and
+/// the total, from one thread at a time, the last call with done == total.
 using ProgressCallback = std::function<void(std::size_t done, std::size_t total)>;
 
 /// Output of a neighbour back-end: for each observation i, the observations it

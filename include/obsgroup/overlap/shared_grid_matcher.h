@@ -20,8 +20,8 @@ namespace obsgroup {
 /// tested against each other observation of it, giving one bit per (point,
 /// nearby observation); then observation by observation, the bits of its
 /// points are added up. Integer counts in fixed places: the result is the
-/// same for any number of threads. Progress is reported in cells and then
-/// observations done. Throws Interrupted when `interrupt` is set.
+/// same for any number of threads. Progress is reported in observations
+/// (the two passes scaled to n). Throws Interrupted when `interrupt` is set.
 MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int threads = 0,
                                    const ProgressCallback& progress = {},
                                    const InterruptFlag* interrupt = nullptr);
