@@ -7,14 +7,6 @@
 
 namespace obsgroup {
 
-void WorldPoints::append(const std::vector<Eigen::Vector3f>& observation_points) {
-  Eigen::AlignedBox3f box;  // default-constructed: empty
-  for (const auto& p : observation_points) box.extend(p);
-  points.insert(points.end(), observation_points.begin(), observation_points.end());
-  offsets.push_back(points.size());
-  boxes.push_back(box);
-}
-
 void WorldPoints::appendAll(const std::vector<std::vector<Eigen::Vector3f>>& per_observation, int threads) {
   const std::size_t first = boxes.size();
   const int n = static_cast<int>(per_observation.size());

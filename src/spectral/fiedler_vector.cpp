@@ -17,8 +17,8 @@ namespace {
 /// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured.
 WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d) {
   // D^-1/2 (D - W) D^-1/2 in one pass over W's columns, the diagonal entry
-  // inserted in row order. The arithmetic is that of the matrix expression
-  // (s_i * (d_i - w_ij)) * s_j, so results do not depend on how it is built.
+  // inserted in row order. The arithmetic is that of the matrix expression,
+  // (s_i * ([i == j] d_i - w_ij)) * s_j, so the results are the same bits.
   const Eigen::Index n = W.outerSize();
   const Eigen::VectorXd diagonal = inv_sqrt_d.cwiseInverse().cwiseAbs2();
   WeightMatrix L(n, n);
@@ -44,6 +44,12 @@ WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& i
   return L;
 }
 
+/// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
+/// null vector of eq. (11)). Its largest eigenvalue is 1/lambda_1, so Lanczos
+/// converges at the rate lambda_1/lambda_2 with no shift to tune. L^+ is
+/// applied exactly by grounding: for b orthogonal to z0, L x = b has a solution
+/// with x_last = 0, found with a Cholesky factor of L without its last row and
+/// column (positive definite for a connected graph).
 class DeflatedLaplacianInverse {
  public:
   using Scalar = double;

@@ -28,10 +28,8 @@ struct WorldPoints {
   const Eigen::Vector3f* begin(int i) const { return points.data() + offsets[i]; }
   const Eigen::Vector3f* end(int i) const { return points.data() + offsets[i + 1]; }
 
-  /// Appends one observation; its box is computed from the points.
-  void append(const std::vector<Eigen::Vector3f>& observation_points);
-  /// Appends many observations at once, copying in parallel (threads <= 0:
-  /// all); the result is the same as appending them one by one.
+  /// Appends observations, one box each computed from its points; copies in
+  /// parallel (threads <= 0: all threads).
   void appendAll(const std::vector<std::vector<Eigen::Vector3f>>& per_observation, int threads = 0);
 };
 
