@@ -498,7 +498,7 @@ void countRow(const Grid& grid, const CellMatches& matches, int i, RowScratch& s
       s.pairs += tested[near[g]] != i;
       tested[near[g]] = i;
     }
-    const std::size_t words = (near_size + 63) / 64;
+    const std::size_t words = matches.words(cell);
     const std::uint64_t* mask = matches.masks.data() + matches.mask_offsets[cell] + std::size_t(own->first) * words;
     for (std::uint32_t p = 0; p < own->count; ++p)
       for (std::size_t w = 0; w < words; ++w, ++mask)
