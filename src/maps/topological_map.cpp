@@ -2,8 +2,10 @@
 
 #include "obsgroup/maps/pose_average.h"
 
+#include <omp.h>
+
 #include <algorithm>
-#include <map>
+#include <tuple>
 #include <stdexcept>
 #include <utility>
 
@@ -51,16 +53,65 @@ std::vector<LocalMapFrame> initialFrames(const Partition& partition, const Weigh
 
 namespace {
 
-struct ArcSupport {
-  std::map<std::pair<int, int>, double> pairs;  // (a, b) with a in `from`, b in `to` -> weight
-  int overlapping = 0, sequence = 0;
-  double weight = 0.0;
+/// A pair of observations, a in local map A and b in a later map B, whose
+/// relative pose supports the arc between the two maps.
+struct CrossPair {
+  int to, a, b;  ///< B, a, b
+  double weight;
+  bool overlap;  ///< W_ab > 0; otherwise a and b follow each other in the input
+  auto key() const { return std::tie(to, a, b); }
 };
+
+/// The pairs joining the members of local map A to later maps, sorted by (B, a, b).
+void crossPairsOf(const LocalMapFrame& A, int node, const std::vector<int>& node_of, const WeightMatrix& W,
+                  std::vector<CrossPair>& pairs) {
+  pairs.clear();
+  const int n = static_cast<int>(node_of.size());
+  for (int a : A.members) {
+    for (WeightMatrix::InnerIterator it(W, a); it; ++it)
+      if (node_of[it.row()] > node && it.value() > 0.0)
+        pairs.push_back({node_of[it.row()], a, static_cast<int>(it.row()), it.value(), true});
+    for (int b : {a - 1, a + 1})
+      if (b >= 0 && b < n && node_of[b] > node) pairs.push_back({node_of[b], a, b, kSequencePairWeight, false});
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const CrossPair& l, const CrossPair& r) { return l.key() < r.key(); });
+}
+
+/// The arc from map `from` supported by pairs[begin, end), which all join the
+/// same later map, sorted by (a, b); a pair both overlapping and consecutive
+/// counts once, with its larger weight. to_local[i] = M_i pose_i^-1 maps global
+/// coordinates to the frame of i's local map, so a pair's estimate
+/// M_a (pose_a^-1 pose_b) M_b^-1 is to_local[a] to_local[b]^-1.
+TopologicalArc makeArc(int from, const std::vector<CrossPair>& pairs, std::size_t begin, std::size_t end,
+                       const std::vector<Eigen::Isometry3d>& to_local) {
+  TopologicalArc arc;
+  arc.from = from;
+  arc.to = pairs[begin].to;
+  std::vector<Eigen::Isometry3d> estimates;
+  std::vector<double> weights;
+  for (std::size_t k = begin; k < end; ++k) {
+    const CrossPair& p = pairs[k];
+    (p.overlap ? arc.overlapping_pairs : arc.sequence_pairs) += 1;
+    if (p.overlap) arc.weight += p.weight;
+    if (k > begin && p.a == pairs[k - 1].a && p.b == pairs[k - 1].b) {
+      weights.back() = std::max(weights.back(), p.weight);
+      continue;
+    }
+    estimates.push_back(to_local[p.a] * to_local[p.b].inverse());
+    weights.push_back(p.weight);
+  }
+  const PoseAverage average = averagePoses(estimates, weights);
+  arc.transform = average.mean;
+  arc.translation_spread = average.translation_spread;
+  arc.rotation_spread = average.rotation_spread;
+  arc.pairs = static_cast<int>(estimates.size());
+  return arc;
+}
 
 }  // namespace
 
 TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
-                                   const std::vector<Eigen::Isometry3d>& poses) {
+                                   const std::vector<Eigen::Isometry3d>& poses, int threads) {
   const int n = static_cast<int>(poses.size());
   if (W.rows() != n) throw std::invalid_argument("buildTopologicalMap: W and poses disagree in size");
   std::vector<int> node_of(n, -1);
@@ -69,46 +120,28 @@ TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const Weigh
   for (int i = 0; i < n; ++i)
     if (node_of[i] < 0) throw std::invalid_argument("buildTopologicalMap: an observation is in no local map");
 
-  std::map<std::pair<int, int>, ArcSupport> support;
-  const auto add = [&](int a, int b, double w, bool overlap) {
-    if (node_of[a] == node_of[b]) return;
-    if (node_of[a] > node_of[b]) std::swap(a, b);
-    ArcSupport& s = support[{node_of[a], node_of[b]}];
-    auto [it, inserted] = s.pairs.emplace(std::make_pair(a, b), w);
-    if (!inserted) it->second = std::max(it->second, w);
-    (overlap ? s.overlapping : s.sequence) += 1;
-    if (overlap) s.weight += w;
-  };
-  for (int b = 0; b < W.outerSize(); ++b)
-    for (WeightMatrix::InnerIterator it(W, b); it; ++it)
-      if (it.row() < b && it.value() > 0.0) add(static_cast<int>(it.row()), b, it.value(), true);
-  for (int i = 0; i + 1 < n; ++i) add(i, i + 1, kSequencePairWeight, false);
+  std::vector<Eigen::Isometry3d> to_local(n);
+  for (const LocalMapFrame& node : nodes)
+    for (std::size_t k = 0; k < node.members.size(); ++k)
+      to_local[node.members[k]] = node.member_poses.at(k) * poses[node.members[k]].inverse();
 
   TopologicalMap map;
   map.nodes = std::move(nodes);
-  for (const auto& [key, s] : support) {
-    const LocalMapFrame& A = map.nodes[key.first];
-    const LocalMapFrame& B = map.nodes[key.second];
-    std::vector<Eigen::Isometry3d> estimates;
-    std::vector<double> weights;
-    for (const auto& [pair, w] : s.pairs) {
-      const auto [a, b] = pair;
-      estimates.push_back(A.memberPose(a) * (poses[a].inverse() * poses[b]) * B.memberPose(b).inverse());
-      weights.push_back(w);
+  const int maps = static_cast<int>(map.nodes.size());
+  std::vector<std::vector<TopologicalArc>> arcs_from(maps);  // arcs_from[A]: the arcs (A, B > A), by B
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
+  {
+    std::vector<CrossPair> pairs;
+#pragma omp for schedule(dynamic, 4)
+    for (int A = 0; A < maps; ++A) {
+      crossPairsOf(map.nodes[A], A, node_of, W, pairs);
+      for (std::size_t begin = 0, end; begin < pairs.size(); begin = end) {
+        for (end = begin + 1; end < pairs.size() && pairs[end].to == pairs[begin].to;) ++end;
+        arcs_from[A].push_back(makeArc(A, pairs, begin, end, to_local));
+      }
     }
-    const PoseAverage average = averagePoses(estimates, weights);
-    TopologicalArc arc;
-    arc.from = key.first;
-    arc.to = key.second;
-    arc.transform = average.mean;
-    arc.translation_spread = average.translation_spread;
-    arc.rotation_spread = average.rotation_spread;
-    arc.weight = s.weight;
-    arc.overlapping_pairs = s.overlapping;
-    arc.sequence_pairs = s.sequence;
-    arc.pairs = static_cast<int>(s.pairs.size());
-    map.arcs.push_back(arc);
   }
+  for (auto& arcs : arcs_from) map.arcs.insert(map.arcs.end(), arcs.begin(), arcs.end());
   return map;
 }
 

@@ -63,9 +63,10 @@ inline constexpr double kSequencePairWeight = 1e-3;
 /// from A's reference frame to B's, where M are the members' (possibly
 /// refined) poses in their local maps; the arc holds the W-weighted mean
 /// (averagePoses) and its spread. With unrefined local maps all estimates
-/// coincide and the spread is 0.
+/// coincide and the spread is 0. The arcs are averaged on `threads` threads
+/// (0 = all cores); the result is the same for any number.
 TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
-                                   const std::vector<Eigen::Isometry3d>& poses);
+                                   const std::vector<Eigen::Isometry3d>& poses, int threads = 0);
 
 /// The frames of all groups of a partition from the input poses.
 std::vector<LocalMapFrame> initialFrames(const Partition& partition, const WeightMatrix& W,
