@@ -33,25 +33,52 @@ nlohmann::json poseToJson(const Eigen::Isometry3d& pose) {
   return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"qw", q.w()}, {"qx", q.x()}, {"qy", q.y()}, {"qz", q.z()}};
 }
 
-/// A JSON array with one element per line, indented.
-std::string arrayPerLine(const std::vector<nlohmann::json>& items) {
-  if (items.empty()) return "[]";
-  std::string out = "[\n";
-  for (std::size_t k = 0; k < items.size(); ++k) out += "    " + items[k].dump() + (k + 1 < items.size() ? ",\n" : "\n");
+/// A JSON array with one element per line, indented; element k is item(k).
+/// The elements are made on all cores (a big map has tens of thousands) and
+/// joined in order.
+template <typename Item>
+std::string arrayPerLine(std::size_t size, const Item& item) {
+  if (size == 0) return "[]";
+  std::vector<std::string> lines(size);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::size_t k = 0; k < size; ++k) lines[k] = item(k).dump();
+  std::size_t length = 4;
+  for (const auto& line : lines) length += line.size() + 6;
+  std::string out;
+  out.reserve(length);
+  out += "[\n";
+  for (std::size_t k = 0; k < size; ++k) (out += "    ") += lines[k] + (k + 1 < size ? ",\n" : "\n");
   return out + "  ]";
+}
+
+nlohmann::json nodeToJson(const LocalMapFrame& node, std::size_t id) {
+  std::vector<nlohmann::json> member_poses;
+  for (const auto& pose : node.member_poses) member_poses.push_back(poseToJson(pose));
+  return {{"id", id}, {"reference", node.reference}, {"pose", poseToJson(node.pose)},
+          {"members", node.members}, {"member_poses", member_poses}};
+}
+
+nlohmann::json arcToJson(const TopologicalArc& arc) {
+  return {{"from", arc.from},
+          {"to", arc.to},
+          {"transform", poseToJson(arc.transform)},
+          {"spread", {{"translation_m", arc.translation_spread}, {"rotation_rad", arc.rotation_spread}}},
+          {"weight", arc.weight},
+          {"pairs", arc.pairs},
+          {"overlapping_pairs", arc.overlapping_pairs},
+          {"sequence_pairs", arc.sequence_pairs}};
 }
 
 }  // namespace
 
 std::string partitionJson(const Partition& partition, const RunRecord& run) {
-  std::vector<nlohmann::json> groups(partition.groups.begin(), partition.groups.end());
-  std::vector<nlohmann::json> splits;
-  for (std::size_t s = 0; s < partition.splits.size(); ++s) splits.push_back(splitToJson(partition.splits[s], s));
+  const auto group = [&](std::size_t g) { return nlohmann::json(partition.groups[g]); };
+  const auto split = [&](std::size_t s) { return splitToJson(partition.splits[s], s); };
   std::ostringstream out;
   out << "{\n"
       << "  \"observations\": " << partition.group_of.size() << ",\n"
-      << "  \"groups\": " << arrayPerLine(groups) << ",\n"
-      << "  \"splits\": " << arrayPerLine(splits) << ",\n"
+      << "  \"groups\": " << arrayPerLine(partition.groups.size(), group) << ",\n"
+      << "  \"splits\": " << arrayPerLine(partition.splits.size(), split) << ",\n"
       << "  \"parameters\": " << run.parameters.dump() << ",\n"
       << "  \"statistics\": " << run.statistics.dump() << ",\n"
       << "  \"warnings\": " << nlohmann::json(run.warnings).dump() << ",\n"
@@ -62,24 +89,10 @@ std::string partitionJson(const Partition& partition, const RunRecord& run) {
 }
 
 std::string topologyJson(const TopologicalMap& map) {
-  std::vector<nlohmann::json> nodes, arcs;
-  for (std::size_t k = 0; k < map.nodes.size(); ++k) {
-    const auto& node = map.nodes[k];
-    std::vector<nlohmann::json> member_poses;
-    for (const auto& pose : node.member_poses) member_poses.push_back(poseToJson(pose));
-    nodes.push_back({{"id", k}, {"reference", node.reference}, {"pose", poseToJson(node.pose)},
-                     {"members", node.members}, {"member_poses", member_poses}});
-  }
-  for (const auto& arc : map.arcs)
-    arcs.push_back({{"from", arc.from},
-                    {"to", arc.to},
-                    {"transform", poseToJson(arc.transform)},
-                    {"spread", {{"translation_m", arc.translation_spread}, {"rotation_rad", arc.rotation_spread}}},
-                    {"weight", arc.weight},
-                    {"pairs", arc.pairs},
-                    {"overlapping_pairs", arc.overlapping_pairs},
-                    {"sequence_pairs", arc.sequence_pairs}});
-  return "{\n  \"nodes\": " + arrayPerLine(nodes) + ",\n  \"arcs\": " + arrayPerLine(arcs) + "\n}\n";
+  const auto node = [&](std::size_t k) { return nodeToJson(map.nodes[k], k); };
+  const auto arc = [&](std::size_t k) { return arcToJson(map.arcs[k]); };
+  return "{\n  \"nodes\": " + arrayPerLine(map.nodes.size(), node) + ",\n  \"arcs\": " +
+         arrayPerLine(map.arcs.size(), arc) + "\n}\n";
 }
 
 std::string localMapPosesTum(const TopologicalMap& map) {
