@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 using namespace obsgroup::io;
 namespace fs = std::filesystem;
@@ -151,4 +152,69 @@ TEST(Readers, InMemoryAndFileReadsAgree) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("poses.txt:2: field 'tz'"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+
+/// A CARMEN log of `scans` FLASER lines of 180 beams, over 1 MB, so that it
+/// is parsed in slices; line k is replaced where `replace` says.
+std::string bigLog(int scans, const std::map<int, std::string>& replace = {}) {
+  std::string log = "PARAM robot_front_laser_max 30 0 host 0\n";
+  for (int k = 1; k <= scans; ++k) {
+    if (const auto it = replace.find(k + 1); it != replace.end()) {
+      log += it->second + "\n";
+      continue;
+    }
+    std::string line = "FLASER 180";
+    for (int b = 0; b < 180; ++b) line += ' ' + std::to_string(1.0 + 0.01 * ((k + b) % 300));
+    line += ' ' + std::to_string(0.1 * k) + " 0.5 0.01 0 0 0 " + std::to_string(k) + " host 0\n";
+    log += line;
+  }
+  return log;
+}
+
+std::string errorOfLog(const std::string& log, int threads) {
+  CarmenOptions options;
+  options.threads = threads;
+  try {
+    parseCarmenLog(log, "big.clf", options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Readers, LargeLogsParseTheSameOnAnyNumberOfThreads) {
+  const std::string log = bigLog(1200, {{900, "PARAM robot_front_laser_max 20 0 host 0"}});
+  ASSERT_GT(log.size(), std::size_t(1) << 20);
+  CarmenOptions one, four;
+  one.threads = 1;
+  four.threads = 4;
+  const CarmenLog a = parseCarmenLog(log, "big.clf", one), b = parseCarmenLog(log, "big.clf", four);
+  ASSERT_EQ(a.scans.size(), 1199u);
+  ASSERT_EQ(b.scans.size(), a.scans.size());
+  for (std::size_t k = 0; k < a.scans.size(); ++k) {
+    EXPECT_EQ(a.scans[k].line, b.scans[k].line);
+    EXPECT_EQ(a.scans[k].ranges, b.scans[k].ranges);
+    EXPECT_TRUE(a.scans[k].laser_pose.isApprox(b.scans[k].laser_pose, 0.0));
+    EXPECT_EQ(b.scans[k].max_range, 20.0);  // the last PARAM applies to all, as with one thread
+  }
+}
+
+TEST(Readers, TheFirstBadLineOfALargeLogIsReportedOnAnyNumberOfThreads) {
+  // Errors in the first and the last slice, and a bad PARAM line between them.
+  const std::string log = bigLog(1200, {{1100, "FLASER 2 1.0"},
+                                        {700, "PARAM robot_front_laser_max abc 0 host 0"},
+                                        {1150, "FLASER 3 1 2 x 0 0 0 0 0 0 0 host 0"}});
+  for (int threads : {1, 2, 3, 8}) {
+    const std::string error = errorOfLog(log, threads);
+    EXPECT_NE(error.find("big.clf:700: field 'PARAM robot_front_laser_max': 'abc'"), std::string::npos)
+        << threads << " threads: " << error;
+  }
+  const std::string later = bigLog(1200, {{1100, "FLASER 2 1.0"}, {1150, "FLASER 3 1 2 x 0 0 0 0 0 0 0 host 0"}});
+  for (int threads : {1, 2, 3, 8})
+    EXPECT_NE(errorOfLog(later, threads).find("big.clf:1100: FLASER line is truncated"), std::string::npos)
+        << threads << " threads";
 }

@@ -12,6 +12,8 @@
 #include <obsgroup/maps/topological_map.h>
 #include <obsgroup/observation_grouping.h>
 
+#include <omp.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -122,7 +124,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   }
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& o : observations) poses.push_back(o.pose);
-  const TopologicalMap topology = buildTopologicalMap(std::move(frames), grouping.getWeightMatrix(), poses);
+  const TopologicalMap topology = buildTopologicalMap(std::move(frames), grouping.getWeightMatrix(), poses, args.threads);
   const double maps_s = secondsSince(maps_start);
 
   const auto outputs_start = Clock::now();
@@ -191,13 +193,17 @@ int runCarmen(const PartitionArgs& args) {
   options.laser = args.laser;
   options.field_of_view_deg = args.field_of_view_deg;
   options.max_range = args.max_range;
+  options.threads = args.threads;
   io::CarmenLog log = io::readCarmenLog(args.input, options);
-  std::vector<Observation<pcl::PointXYZ>> observations;
+  const int n = static_cast<int>(log.scans.size());
+  std::vector<Observation<pcl::PointXYZ>> observations(n);
   InputRecord input;
   input.format = "carmen";
-  for (const auto& scan : log.scans) {
-    observations.push_back({io::scanToCloud(scan), scan.laser_pose});
-    input.labels.push_back(args.input + ":" + std::to_string(scan.line));
+  input.labels.resize(n);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    observations[i] = {io::scanToCloud(log.scans[i]), log.scans[i].laser_pose};
+    input.labels[i] = args.input + ":" + std::to_string(log.scans[i].line);
   }
   // The beam geometry actually used (from the messages, PARAM lines or options), as read off the first scan.
   const io::LaserScan& first = log.scans.front();
@@ -231,6 +237,7 @@ int runPcd(const PartitionArgs& args, const std::vector<std::string>& files, io:
 }  // namespace
 
 int runPartition(const PartitionArgs& args) {
+  if (args.threads > 0) omp_set_num_threads(args.threads);  // every parallel stage, the writers' too
   const std::string format = detectFormat(args);
   checkOptionsFit(args, format);
   io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after

@@ -3,7 +3,11 @@
 #include "errors.h"
 #include "text_fields.h"
 
+#include <algorithm>
 #include <cmath>
+#include <exception>
+#include <iterator>
+#include <thread>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -65,8 +69,11 @@ void requireFieldCount(const std::vector<std::string_view>& fields, std::size_t 
 void readRanges(const std::vector<std::string_view>& fields, std::size_t first, long n, const LineRef& where,
                 LaserScan& scan) {
   scan.ranges.resize(n);
-  for (long k = 0; k < n; ++k)
-    scan.ranges[k] = parseDouble(fields[first + k], where, "range " + std::to_string(k + 1));  // nan/inf: no return
+  for (long k = 0; k < n; ++k) {  // nan/inf: no return
+    const std::optional<double> range = toDouble(fields[first + k]);
+    if (!range) throwNotANumber(fields[first + k], where, "range " + std::to_string(k + 1));
+    scan.ranges[k] = *range;
+  }
 }
 
 Eigen::Isometry3d parsePose(const std::vector<std::string_view>& fields, std::size_t first, const LineRef& where,
@@ -183,6 +190,76 @@ bool hasReturn(const LaserScan& scan) {
   return false;
 }
 
+/// The first error met, by line number.
+struct Failure {
+  std::size_t line = 0;
+  std::exception_ptr error;
+  void keepFirst(std::size_t at, std::exception_ptr e) {
+    if (!error || at < line) {
+      line = at;
+      error = std::move(e);
+    }
+  }
+};
+
+/// What parsing a slice of the log's lines gave: the scans of the chosen
+/// message, the PARAM lines (indices into the lines, read later in order),
+/// and the first error, after which the slice stops.
+struct ParsedSlice {
+  std::vector<LaserScan> scans;
+  std::vector<std::size_t> param_lines;
+  Failure failure;
+};
+
+using NumberedLines = std::vector<std::pair<std::size_t, std::string_view>>;  // (line number, text)
+
+void parseSlice(const NumberedLines& lines, std::size_t begin, std::size_t end, const std::string& path,
+                LaserSource source, ParsedSlice& out) {
+  const std::string_view chosen = messageName(source);
+  for (std::size_t k = begin; k < end; ++k) {
+    const auto& [line_number, line] = lines[k];
+    try {
+      const auto fields = splitFields(line);
+      if (fields.empty() || fields[0].front() == '#') continue;
+      if (fields[0] == "PARAM") {
+        out.param_lines.push_back(k);
+      } else if (fields[0] == chosen) {
+        const LineRef where{path, line_number};
+        LaserScan scan = source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
+                                                           : parseFrontOrRearLaser(fields, where);
+        scan.line = line_number;
+        out.scans.push_back(std::move(scan));
+      }
+    } catch (...) {
+      out.failure.keepFirst(line_number, std::current_exception());
+      return;
+    }
+  }
+}
+
+/// Threads worth starting for a log of `bytes`: small logs (and fuzzing
+/// inputs) are parsed on the calling thread.
+unsigned threadsFor(std::size_t bytes, const CarmenOptions& options) {
+  if (bytes < (std::size_t(1) << 20)) return 1;
+  const unsigned all = std::max(1u, std::thread::hardware_concurrency());
+  return options.threads > 0 ? static_cast<unsigned>(options.threads) : all;
+}
+
+/// The lines cut into one slice per thread, parsed in parallel; the slices
+/// are in line order, so the result does not depend on the thread count.
+std::vector<ParsedSlice> parseSlices(const NumberedLines& lines, const std::string& path, LaserSource source,
+                                     unsigned threads) {
+  const std::size_t count = std::max<std::size_t>(1, std::min<std::size_t>(threads, lines.size()));
+  std::vector<ParsedSlice> slices(count);
+  const auto bound = [&](std::size_t t) { return lines.size() * t / count; };
+  std::vector<std::thread> workers;
+  for (std::size_t t = 1; t < count; ++t)
+    workers.emplace_back([&, t] { parseSlice(lines, bound(t), bound(t + 1), path, source, slices[t]); });
+  parseSlice(lines, bound(0), bound(1), path, source, slices[0]);
+  for (auto& worker : workers) worker.join();
+  return slices;
+}
+
 }  // namespace
 
 CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
@@ -194,7 +271,7 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
 
   // First pass: which laser messages the log holds.
   std::map<LaserSource, std::size_t> counts;
-  std::vector<std::pair<std::size_t, std::string_view>> lines;  // (line number, text)
+  NumberedLines lines;
   std::size_t number = 0;
   for (std::size_t start = 0; start < content.size();) {
     std::size_t end = content.find('\n', start);
@@ -232,21 +309,30 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
     log.warnings.push_back(path + ": using the " + std::to_string(counts[log.source]) + " " + chosen +
                            " scans; the log also has " + others + " (choose with --laser)");
 
-  // Second pass: parse the chosen messages and the PARAM lines.
+  // Second pass: parse the chosen messages, slices of lines in parallel,
+  // and then the PARAM lines in order.
+  const std::vector<ParsedSlice> slices = parseSlices(lines, path, log.source, threadsFor(content.size(), options));
   LaserParams params;
-  for (const auto& [line_number, line] : lines) {
-    const auto fields = splitFields(line);
-    if (fields.empty() || fields[0].front() == '#') continue;
-    const LineRef where{path, line_number};
-    if (fields[0] == "PARAM") {
-      readParam(fields, where, params);
-    } else if (fields[0] == chosen) {
-      LaserScan scan = log.source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
-                                                             : parseFrontOrRearLaser(fields, where);
-      scan.line = line_number;
-      log.scans.push_back(std::move(scan));
+  Failure first_failure;
+  for (const ParsedSlice& slice : slices) {
+    for (std::size_t k : slice.param_lines) {
+      const LineRef where{path, lines[k].first};
+      try {
+        readParam(splitFields(lines[k].second), where, params);
+      } catch (...) {
+        first_failure.keepFirst(lines[k].first, std::current_exception());
+        break;
+      }
+    }
+    if (slice.failure.error) {
+      first_failure.keepFirst(slice.failure.line, slice.failure.error);
+      break;  // later slices hold later lines
     }
   }
+  if (first_failure.error) std::rethrow_exception(first_failure.error);
+  for (const ParsedSlice& slice : slices)
+    log.scans.insert(log.scans.end(), std::make_move_iterator(slice.scans.begin()),
+                     std::make_move_iterator(slice.scans.end()));
   for (LaserScan& scan : log.scans) {
     if (log.source != LaserSource::RobotLaser) applyGeometry(scan, log.source, params, options);
     if (options.max_range) scan.max_range = *options.max_range;

@@ -29,6 +29,8 @@ struct CarmenOptions {
   /// Readings at or beyond this range are "no return"; default: the
   /// message's own (ROBOTLASER1), the log's PARAM, else 80 m.
   std::optional<double> max_range;
+  /// Threads parsing a large log (0 = all cores); the result is the same for any number.
+  int threads = 0;
 };
 
 /// One scan: ranges and beam geometry in the laser frame (x ahead, y left),

@@ -6,6 +6,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,16 +32,26 @@ struct LineRef {
   std::size_t line;
 };
 
+/// The field as a double ("nan" and "inf" are accepted), or nothing when it
+/// is not a number.
+inline std::optional<double> toDouble(std::string_view field) {
+  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+  if (ec != std::errc() || end != field.data() + field.size()) return std::nullopt;
+  return value;
+}
+
+[[noreturn]] inline void throwNotANumber(std::string_view field, const LineRef& where, const std::string& name) {
+  throw inputError(where.file, where.line, "field '" + name + "': '" + std::string(field) + "' is not a number");
+}
+
 /// The field as a double ("nan" and "inf" are accepted: the caller decides
 /// whether a non-finite value is allowed).
 inline double parseDouble(std::string_view field, const LineRef& where, const std::string& name) {
-  std::string_view text = field;
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  double value = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size())
-    throw inputError(where.file, where.line, "field '" + name + "': '" + std::string(field) + "' is not a number");
-  return value;
+  const std::optional<double> value = toDouble(field);
+  if (!value) throwNotANumber(field, where, name);
+  return *value;
 }
 
 /// The field as a finite double.
