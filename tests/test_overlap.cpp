@@ -227,30 +227,33 @@ TEST(SensedSpaceOverlap, ThreadCountDoesNotChangeTheMatrix) {
 }
 
 TEST(SensedSpaceOverlap, CrowdedDenseCloudsMatchTheBruteForceReference) {
-  // 150 small 3D clouds crowded into a 0.6 m cube: every cell's neighbourhood
-  // holds more than 64 observations (several words of match bits per point),
-  // each with many points there, and some pairs sit exactly delta apart.
-  std::vector<Observation<pcl::PointXYZ>> obs;
-  std::uint32_t state = 12345;
-  const auto uniform = [&state]() {
-    state = state * 1664525u + 1013904223u;
-    return float(state >> 8) / float(1u << 24);
-  };
-  for (int i = 0; i < 150; ++i) {
-    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-    for (int k = 0; k < 40; ++k) cloud->push_back(pcl::PointXYZ(0.6f * uniform(), 0.6f * uniform(), 0.6f * uniform()));
-    cloud->push_back(pcl::PointXYZ(0.25f * float(i % 3), 0.0f, 0.0f));  // 0.25 apart: at delta = 0.25 exactly
-    obs.push_back({cloud, Eigen::Isometry3d::Identity()});
-  }
-  for (const double delta : {0.05, 0.25}) {
-    const OverlapResult grid = overlapWith(obs, NeighbourSearch::SharedGrid, delta, 0.0, 2);
-    expectSameMatrix<pcl::PointXYZ>(grid, overlapWith(obs, NeighbourSearch::PclSearch, delta));
-    expectSameMatrix<pcl::PointXYZ>(grid, overlapWith(obs, NeighbourSearch::SharedGrid, delta, 0.0, 1));
-    for (std::size_t i = 0; i < obs.size(); i += 7) {
-      for (std::size_t j = 0; j < obs.size(); j += 5) {
-        if (i == j) continue;
-        EXPECT_NEAR(grid.match_ratio.coeff(i, j), test::bruteForceMatchRatio(obs[i], obs[j], delta), 1e-12)
-            << i << " " << j << " delta " << delta;
+  // Small 3D clouds crowded into a 0.6 m cube, each with many points in every
+  // cell's neighbourhood, and some pairs exactly delta apart. With 50 clouds
+  // a neighbourhood holds 33 to 50 observations (the match bits of a point fill
+  // both halves of one word); with 150, more than 64 (several words).
+  for (const int clouds : {50, 150}) {
+    std::vector<Observation<pcl::PointXYZ>> obs;
+    std::uint32_t state = 12345;
+    const auto uniform = [&state]() {
+      state = state * 1664525u + 1013904223u;
+      return float(state >> 8) / float(1u << 24);
+    };
+    for (int i = 0; i < clouds; ++i) {
+      pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+      for (int k = 0; k < 40; ++k) cloud->push_back(pcl::PointXYZ(0.6f * uniform(), 0.6f * uniform(), 0.6f * uniform()));
+      cloud->push_back(pcl::PointXYZ(0.25f * float(i % 3), 0.0f, 0.0f));  // 0.25 apart: at delta = 0.25 exactly
+      obs.push_back({cloud, Eigen::Isometry3d::Identity()});
+    }
+    for (const double delta : {0.05, 0.25}) {
+      const OverlapResult grid = overlapWith(obs, NeighbourSearch::SharedGrid, delta, 0.0, 2);
+      expectSameMatrix<pcl::PointXYZ>(grid, overlapWith(obs, NeighbourSearch::PclSearch, delta));
+      expectSameMatrix<pcl::PointXYZ>(grid, overlapWith(obs, NeighbourSearch::SharedGrid, delta, 0.0, 1));
+      for (std::size_t i = 0; i < obs.size(); i += 7) {
+        for (std::size_t j = 0; j < obs.size(); j += 5) {
+          if (i == j) continue;
+          EXPECT_NEAR(grid.match_ratio.coeff(i, j), test::bruteForceMatchRatio(obs[i], obs[j], delta), 1e-12)
+              << clouds << " clouds: " << i << " " << j << " delta " << delta;
+        }
       }
     }
   }

@@ -316,6 +316,34 @@ std::uint8_t floatMatches(const Eigen::Vector3f& p, float inside, float outside,
   return border;
 }
 
+/// The float test of MatchDistance when the neighbourhood has at most 64
+/// groups: the OR of the group bits of the points within delta of p, in one
+/// loop that the compiler vectorises; `border` as for floatMatches. The bits
+/// are kept as two 32-bit halves, the width of the float comparisons, so no
+/// lane is widened.
+template <bool Planar>
+std::uint64_t floatMatchBits(const Eigen::Vector3f& p, float inside, float outside, const float* __restrict x,
+                             const float* __restrict y, const float* __restrict z,
+                             const std::uint32_t* __restrict low_bit, const std::uint32_t* __restrict high_bit,
+                             std::uint32_t begin, std::uint32_t end, std::uint8_t& border) {
+  const float px = p.x(), py = p.y(), pz = p.z();
+  std::uint32_t low = 0, high = 0, band = 0;
+  for (std::uint32_t q = begin; q < end; ++q) {
+    const float dx = px - x[q], dy = py - y[q];
+    float d = dx * dx + dy * dy;
+    if (!Planar) {
+      const float dz = pz - z[q];
+      d += dz * dz;
+    }
+    const std::uint32_t hit = std::uint32_t(0) - std::uint32_t(d < inside);
+    low |= low_bit[q] & hit;
+    high |= high_bit[q] & hit;
+    band |= std::uint32_t(d >= inside) & std::uint32_t(d <= outside);
+  }
+  border |= band != 0;
+  return std::uint64_t(high) << 32 | low;
+}
+
 /// keep[n]: a word whose first n bytes in memory are 0xff and the rest 0,
 /// whatever the endianness.
 struct ByteMasks {
@@ -348,6 +376,9 @@ struct NeighbourhoodScratch {
   std::vector<std::uint32_t> mark, group;  // stamp of the last cell that saw j, and j's group there
   std::vector<std::uint32_t> group_begin, cursor;
   std::vector<float> x, y, z;
+  /// The bit of the point's group, 1 << g when the groups fit in one word,
+  /// as its low and high halves.
+  std::vector<std::uint32_t> low_bit, high_bit;
   std::vector<std::uint8_t> hit;
 };
 
@@ -373,16 +404,21 @@ std::uint32_t groupNeighbourhood(const Grid& grid, std::size_t c, std::int32_t* 
   s.x.resize(total);
   s.y.resize(total);
   s.z.resize(total);
-  s.hit.assign(total + 8, 0);
+  s.low_bit.resize(total);
+  s.high_bit.resize(total);
+  if (groups > 64) s.hit.assign(total + 8, 0);  // only the multi-word path reads hit bytes
   s.cursor.assign(s.group_begin.begin(), s.group_begin.end() - 1);
   const Eigen::Vector3f* points = grid.points().data();
   for (int h = 0; h < grid.columns(); ++h)
     for (std::uint32_t r = slices[h].begin; r < slices[h].end; ++r) {
-      std::uint32_t& at = s.cursor[s.group[runs[r].observation]];
+      const std::uint32_t g = s.group[runs[r].observation];
+      std::uint32_t& at = s.cursor[g];
       for (std::uint32_t q = runs[r].begin; q < runs[r].end; ++q, ++at) {
         s.x[at] = points[q].x();
         s.y[at] = points[q].y();
         s.z[at] = points[q].z();
+        s.low_bit[at] = g < 32 ? std::uint32_t(1) << g : 0;
+        s.high_bit[at] = g >= 32 && g < 64 ? std::uint32_t(1) << (g - 32) : 0;
       }
     }
   return groups;
@@ -397,7 +433,24 @@ void matchPoint(const Eigen::Vector3f& p, std::uint32_t self, std::uint32_t grou
   const std::uint32_t own_begin = s.group_begin[self], own_end = s.group_begin[self + 1];
   std::uint8_t* hit = s.hit.data();
   const float *x = s.x.data(), *y = s.y.data(), *z = s.z.data();
-  std::uint8_t border;
+  std::uint8_t border = 0;
+  if (groups <= 64) {  // the usual case: the group bits are ORed as the distances are tested
+    const std::uint32_t *low = s.low_bit.data(), *high = s.high_bit.data();
+    std::uint64_t word;
+    if (own_end - own_begin <= 16) {
+      word = floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, 0, total, border);
+    } else {
+      word = floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, 0, own_begin, border);
+      word |= floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, own_end, total, border);
+    }
+    if (border) {  // rare: a distance within 1e-4 of delta, decided in double
+      word = 0;
+      for (std::uint32_t q = 0; q < total; ++q)
+        if (within(p, Eigen::Vector3f(x[q], y[q], z[q]))) word |= std::uint64_t(high[q]) << 32 | low[q];
+    }
+    mask[0] = word & ~(std::uint64_t(1) << self);
+    return;
+  }
   if (own_end - own_begin <= 16) {  // one loop is cheaper than skipping a few points
     border = floatMatches<Planar>(p, inside, outside, x, y, z, hit, 0, total);
   } else {  // dense clouds: most of the neighbourhood is the point's own observation
