@@ -172,8 +172,7 @@ class Grid {
     const std::size_t total = entries.size();
     flat_ = std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.key.z == entries[0].key.z; });
     columns_ = flat_ ? 3 : 9;
-    // The gathers are random reads: done in parallel, then the runs are cut
-    // in one sequential sweep.
+    // The gathers are random reads, done in parallel.
     std::vector<std::int32_t> observation_of(total);
 #pragma omp parallel for num_threads(threads_) schedule(dynamic, 64)
     for (int i = 0; i < world_.size(); ++i)
@@ -186,25 +185,61 @@ class Grid {
       grid_observation[k] = observation_of[entries[k].index];
     }
     observation_of = {};
-    std::vector<CellKey> keys;
-    for (std::size_t k = 0; k < total; ++k) {
-      const std::int32_t observation = grid_observation[k];
-      const bool new_cell = k == 0 || !(entries[k].key == entries[k - 1].key);
-      if (new_cell) {
-        keys.push_back(entries[k].key);
-        cell_runs_.push_back({static_cast<std::uint32_t>(runs_.size()), 0});
-      }
-      if (new_cell || observation != runs_.back().observation) {
-        runs_.push_back(Run{observation, static_cast<std::uint32_t>(k), 0});
-      }
-      runs_.back().end = static_cast<std::uint32_t>(k + 1);
-      cell_runs_.back().end = static_cast<std::uint32_t>(runs_.size());
-    }
+    const std::vector<CellKey> keys = cutRuns(entries, grid_observation);
     entries = {};
     planar_ = std::all_of(points_.begin(), points_.end(), [&](const Eigen::Vector3f& p) { return p.z() == points_[0].z(); });
     indexRunsByObservation();
     buildNeighbourhoods(keys);
     countObservationsNear();
+  }
+
+  /// Cuts the sorted points into cells and runs (one observation's points in
+  /// one cell) and returns the key of each cell. Each thread takes a slice of
+  /// the points and first counts the cells and runs that start in it, so the
+  /// layout is the same for any thread count.
+  std::vector<CellKey> cutRuns(const std::vector<Entry>& entries, const std::vector<std::int32_t>& observation) {
+    const std::size_t total = entries.size();
+    const auto new_cell = [&](std::size_t k) { return k == 0 || !(entries[k].key == entries[k - 1].key); };
+    const auto new_run = [&](std::size_t k) { return new_cell(k) || observation[k] != observation[k - 1]; };
+    const int slices = threads_;
+    std::vector<std::size_t> cells_before(slices + 1, 0), runs_before(slices + 1, 0);
+    const auto bound = [&](int t) { return total * std::size_t(t) / std::size_t(slices); };
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+    for (int t = 0; t < slices; ++t)
+      for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
+        cells_before[t + 1] += new_cell(k);
+        runs_before[t + 1] += new_run(k);
+      }
+    for (int t = 0; t < slices; ++t) {
+      cells_before[t + 1] += cells_before[t];
+      runs_before[t + 1] += runs_before[t];
+    }
+    const std::size_t cells = cells_before[slices], runs = runs_before[slices];
+    std::vector<CellKey> keys(cells);
+    cell_runs_.resize(cells);
+    runs_.resize(runs);
+#pragma omp parallel num_threads(slices)
+    {
+#pragma omp for schedule(static, 1)
+      for (int t = 0; t < slices; ++t) {
+        std::size_t c = cells_before[t], r = runs_before[t];
+        for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
+          if (new_cell(k)) {
+            keys[c] = entries[k].key;
+            cell_runs_[c++].begin = static_cast<std::uint32_t>(r);
+          }
+          if (new_run(k)) runs_[r++] = Run{observation[k], static_cast<std::uint32_t>(k), 0};
+        }
+      }
+      // Each run ends where the next begins, each cell's runs where the next cell's do.
+#pragma omp for schedule(static)
+      for (std::size_t r = 0; r < runs; ++r)
+        runs_[r].end = r + 1 < runs ? runs_[r + 1].begin : static_cast<std::uint32_t>(total);
+#pragma omp for schedule(static)
+      for (std::size_t c = 0; c < cells; ++c)
+        cell_runs_[c].end = c + 1 < cells ? cell_runs_[c + 1].begin : static_cast<std::uint32_t>(runs);
+    }
+    return keys;
   }
 
   /// Each observation's runs in cell order: a counting sort of the runs.
