@@ -205,11 +205,15 @@ class Grid {
     std::vector<std::size_t> cells_before(slices + 1, 0), runs_before(slices + 1, 0);
     const auto bound = [&](int t) { return total * std::size_t(t) / std::size_t(slices); };
 #pragma omp parallel for num_threads(slices) schedule(static, 1)
-    for (int t = 0; t < slices; ++t)
+    for (int t = 0; t < slices; ++t) {
+      std::size_t cells = 0, runs = 0;  // local: the slices' counters share a cache line
       for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
-        cells_before[t + 1] += new_cell(k);
-        runs_before[t + 1] += new_run(k);
+        cells += new_cell(k);
+        runs += new_run(k);
       }
+      cells_before[t + 1] = cells;
+      runs_before[t + 1] = runs;
+    }
     for (int t = 0; t < slices; ++t) {
       cells_before[t + 1] += cells_before[t];
       runs_before[t + 1] += runs_before[t];
