@@ -45,9 +45,18 @@ const char* messageName(LaserSource source) {
 std::string readWholeFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file");
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
+  const std::streamoff size = in.seekg(0, std::ios::end) ? std::streamoff(in.tellg()) : -1;
+  if (size < 0) {  // not seekable (a pipe): stream it
+    in.clear();
+    std::ostringstream content;
+    content << in.rdbuf();
+    return content.str();
+  }
+  std::string content(static_cast<std::size_t>(size), '\0');  // a regular file: one read
+  in.seekg(0);
+  in.read(content.data(), size);
+  content.resize(static_cast<std::size_t>(in.gcount()));
+  return content;
 }
 
 /// Checks that a message line has exactly `expected` fields; otherwise names
