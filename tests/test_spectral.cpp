@@ -1,5 +1,6 @@
 // The Fiedler vector of eq. (10)-(11) and the split criteria of sec. II-A.
 #include <obsgroup/spectral/fiedler_vector.h>
+#include <obsgroup/partition/recursive_partitioner.h>
 #include <obsgroup/spectral/spectral_bisection.h>
 
 #include <gtest/gtest.h>
@@ -154,4 +155,43 @@ TEST(SpectralBisection, BestNcutHonoursTheMinimumSide) {
   const auto size_a = std::count(b.in_a.begin(), b.in_a.end(), true);
   EXPECT_GE(size_a, 45);
   EXPECT_LE(size_a, 55);
+}
+
+TEST(Fiedler, AnyEliminationOrderGivesTheSameVector) {
+  // The elimination order only changes the fill of the factor (the speed),
+  // never the eigenvector: AMD's, the natural one, a reversed and a shuffled one.
+  const WeightMatrix W = routeGraph(1000, 8, 11);
+  const FiedlerResult amd = fiedlerVector(W, withSolver(EigenSolver::Sparse));
+  std::vector<int> natural(1000), reversed(1000), shuffled(1000);
+  for (int i = 0; i < 1000; ++i) natural[i] = shuffled[i] = i, reversed[i] = 999 - i;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(5));
+  for (const auto& rank : {natural, reversed, shuffled}) {
+    FiedlerOptions options = withSolver(EigenSolver::Sparse);
+    options.elimination_rank = rank;
+    const FiedlerResult ranked = fiedlerVector(W, options);
+    EXPECT_TRUE(ranked.sparse);
+    EXPECT_NEAR(ranked.eigenvalue, amd.eigenvalue, 1e-12);
+    EXPECT_LT((ranked.y - amd.y).cwiseAbs().maxCoeff(), 1e-8 * amd.y.cwiseAbs().maxCoeff());
+  }
+  FiedlerOptions wrong = withSolver(EigenSolver::Sparse);
+  wrong.elimination_rank = {0, 1, 2};
+  EXPECT_THROW(fiedlerVector(W, wrong), std::invalid_argument);
+}
+
+TEST(Fiedler, ThePartitionerSharesOneEliminationOrderWithEverySubgraph) {
+  // recursivePartition orders the whole graph once and hands each subgraph its
+  // members' ranks; a user's order of the whole graph is used the same way.
+  const WeightMatrix W = routeGraph(1500, 8, 13);
+  PartitionOptions options;
+  options.eigen.solver = EigenSolver::Sparse;
+  const Partition shared = recursivePartition(W, options);
+  options.eigen.elimination_rank.resize(1500);
+  for (int i = 0; i < 1500; ++i) options.eigen.elimination_rank[i] = 1499 - i;
+  const Partition users = recursivePartition(W, options);
+  EXPECT_GE(shared.groups.size(), 5u);  // the five rooms at least
+  EXPECT_EQ(shared.groups, users.groups);
+  ASSERT_EQ(shared.splits.size(), users.splits.size());
+  for (std::size_t s = 0; s < shared.splits.size(); ++s) EXPECT_NEAR(shared.splits[s].ncut, users.splits[s].ncut, 1e-9);
+  options.eigen.elimination_rank = {1, 2, 3};
+  EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
 }

@@ -1,10 +1,12 @@
 #include "obsgroup/spectral/fiedler_vector.h"
 
 #include <Eigen/Dense>
+#include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Spectra/SymEigsSolver.h>
 
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -44,19 +46,44 @@ WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& i
   return L;
 }
 
+using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+
+/// The fill-reducing elimination order of a symmetric matrix, as Eigen's
+/// orderings give it (entry k: the node eliminated k-th): the nodes by
+/// increasing rank when ranks are given (rank[k] for node k; extra entries
+/// are ignored), else AMD's.
+Permutation eliminationOrder(const WeightMatrix& A, const std::vector<int>& rank) {
+  Permutation order;
+  if (rank.empty()) {
+    Eigen::AMDOrdering<int>()(A, order);
+    return order;
+  }
+  order.resize(A.rows());
+  std::iota(order.indices().data(), order.indices().data() + A.rows(), 0);
+  std::stable_sort(order.indices().data(), order.indices().data() + A.rows(),
+                   [&rank](int a, int b) { return rank[a] < rank[b]; });
+  return order;
+}
+
 /// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
 /// null vector of eq. (11)). Its largest eigenvalue is 1/lambda_1, so Lanczos
 /// converges at the rate lambda_1/lambda_2 with no shift to tune. L^+ is
 /// applied exactly by grounding: for b orthogonal to z0, L x = b has a solution
 /// with x_last = 0, found with a Cholesky factor of L without its last row and
-/// column (positive definite for a connected graph).
+/// column (positive definite for a connected graph), factorised in the
+/// elimination order of eliminationOrder.
 class DeflatedLaplacianInverse {
  public:
   using Scalar = double;
 
-  DeflatedLaplacianInverse(const WeightMatrix& L, Eigen::VectorXd z0)
+  DeflatedLaplacianInverse(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& rank)
       : n_(L.rows()), z0_(std::move(z0)) {
-    ldlt_.compute(WeightMatrix(L.topLeftCorner(n_ - 1, n_ - 1)));
+    const WeightMatrix grounded = L.topLeftCorner(n_ - 1, n_ - 1);
+    order_ = eliminationOrder(grounded, rank);
+    to_eliminated_ = order_.inverse();
+    WeightMatrix permuted(n_ - 1, n_ - 1);  // upper triangle, in elimination order
+    permuted.selfadjointView<Eigen::Upper>() = grounded.selfadjointView<Eigen::Lower>().twistedBy(to_eliminated_);
+    ldlt_.compute(permuted);
     if (ldlt_.info() != Eigen::Success)
       throw EigenSolverError("Fiedler vector: the grounded Laplacian could not be factorised");
   }
@@ -66,8 +93,9 @@ class DeflatedLaplacianInverse {
   void perform_op(const double* x_in, double* y_out) const {
     Eigen::Map<const Eigen::VectorXd> x(x_in, n_);
     Eigen::Map<Eigen::VectorXd> y(y_out, n_);
-    Eigen::VectorXd b = x - z0_ * z0_.dot(x);
-    y.head(n_ - 1) = ldlt_.solve(b.head(n_ - 1));
+    const Eigen::VectorXd b = x - z0_ * z0_.dot(x);
+    const Eigen::VectorXd permuted_b = to_eliminated_ * b.head(n_ - 1);
+    y.head(n_ - 1) = order_ * ldlt_.solve(permuted_b);
     y[n_ - 1] = 0.0;
     y -= z0_ * z0_.dot(y);
   }
@@ -75,7 +103,9 @@ class DeflatedLaplacianInverse {
  private:
   Eigen::Index n_;
   Eigen::VectorXd z0_;
-  Eigen::SimplicialLDLT<WeightMatrix> ldlt_;
+  Permutation order_, to_eliminated_;
+  // Already in elimination order: factorised as given.
+  Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt_;
 };
 
 /// Spectra operator for P (I - L) P = P D^-1/2 W D^-1/2 P: its largest
@@ -85,7 +115,8 @@ class DeflatedLaplacianInverse {
 class DeflatedNormalizedAdjacency {
  public:
   using Scalar = double;
-  DeflatedNormalizedAdjacency(const WeightMatrix& L, Eigen::VectorXd z0) : L_(L), z0_(std::move(z0)) {}
+  DeflatedNormalizedAdjacency(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& /*rank*/)
+      : L_(L), z0_(std::move(z0)) {}
   Eigen::Index rows() const { return L_.rows(); }
   Eigen::Index cols() const { return L_.cols(); }
   void perform_op(const double* x_in, double* y_out) const {
@@ -131,7 +162,7 @@ bool solveSparse(const WeightMatrix& L, const Eigen::VectorXd& z0, const Fiedler
                  int ncv, Eigen::VectorXd& z, EigenCheck& checked) {
   std::optional<Operator> op;
   try {
-    op.emplace(L, z0);
+    op.emplace(L, z0, options.elimination_rank);
   } catch (const EigenSolverError&) {
     return false;  // e.g. a factorisation that failed: the next solver takes over
   }
@@ -175,6 +206,8 @@ void fixSign(Eigen::VectorXd& y) {
 FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options) {
   const Eigen::Index n = W.rows();
   if (n < 2) throw std::invalid_argument("Fiedler vector: the graph needs at least two nodes");
+  if (!options.elimination_rank.empty() && Eigen::Index(options.elimination_rank.size()) != n)
+    throw std::invalid_argument("Fiedler vector: elimination_rank needs one rank per node");
   const Eigen::VectorXd d = degrees(W);
   if (d.minCoeff() <= 0.0)
     throw std::invalid_argument("Fiedler vector: a node has zero degree (split components first)");

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include <stdexcept>
+#include <vector>
 
 namespace obsgroup {
 
@@ -33,6 +34,13 @@ struct FiedlerOptions {
   /// Largest graph the dense solver takes over when Lanczos fails (its
   /// memory grows as N^2: 200 MB at 5,000 nodes).
   int dense_fallback_max_size = 5000;
+  /// Optional elimination order for the sparse factorisation: one rank per
+  /// node, eliminated in increasing rank (ties by index). Empty: an AMD
+  /// ordering is computed. recursivePartition computes one fill-reducing
+  /// order of the whole graph and hands each subgraph its members' ranks, so
+  /// no subgraph needs an ordering of its own (given here for the whole
+  /// graph, it is used instead of AMD's). Only speed depends on it.
+  std::vector<int> elimination_rank{};
 };
 
 /// No solver found the Fiedler vector to the required accuracy.
