@@ -213,6 +213,7 @@ int runCarmen(const PartitionArgs& args) {
                       {"max_range", first.max_range},
                       {"point_type", io::toString(io::PointKind::XYZ)}};
   input.warnings = std::move(log.warnings);
+  log.scans = {};  // the ranges are in the clouds now: free them for the rest of the run
   input.load_s = secondsSince(start);
   return runPipeline(args, std::move(observations), std::move(input));
 }
