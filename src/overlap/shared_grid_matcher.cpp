@@ -247,18 +247,39 @@ class Grid {
   }
 
   /// Each observation's runs in cell order: a counting sort of the runs.
+  /// Each thread counts the runs of each observation in its slice of the
+  /// cells; slice t's runs of an observation go after those of slices before
+  /// t, so the result is that of one sequential pass.
   void indexRunsByObservation() {
     const int n = world_.size();
+    const std::size_t cells = cell_runs_.size();
+    const int slices = threads_;
+    const auto bound = [&](int t) { return cells * std::size_t(t) / std::size_t(slices); };
+    std::vector<std::vector<std::uint32_t>> next(slices, std::vector<std::uint32_t>(n, 0));
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+    for (int t = 0; t < slices; ++t)
+      for (std::size_t c = bound(t); c < bound(t + 1); ++c)
+        for (std::uint32_t r = cell_runs_[c].begin; r < cell_runs_[c].end; ++r) ++next[t][runs_[r].observation];
     observation_run_offsets_.assign(n + 1, 0);
-    for (const Run& r : runs_) ++observation_run_offsets_[r.observation + 1];
-    for (int i = 0; i < n; ++i) observation_run_offsets_[i + 1] += observation_run_offsets_[i];
-    observation_runs_.resize(runs_.size());
-    std::vector<std::uint32_t> next(observation_run_offsets_.begin(), observation_run_offsets_.end() - 1);
-    for (std::uint32_t c = 0; c < cell_runs_.size(); ++c) {
-      const std::uint32_t first = runs_[cell_runs_[c].begin].begin;
-      for (std::uint32_t r = cell_runs_[c].begin; r < cell_runs_[c].end; ++r)
-        observation_runs_[next[runs_[r].observation]++] = {c, runs_[r].begin - first, runs_[r].end - runs_[r].begin};
+    std::uint32_t at = 0;
+    for (int i = 0; i < n; ++i) {
+      observation_run_offsets_[i] = at;
+      for (int t = 0; t < slices; ++t) {
+        const std::uint32_t count = next[t][i];
+        next[t][i] = at;
+        at += count;
+      }
     }
+    observation_run_offsets_[n] = at;
+    observation_runs_.resize(runs_.size());
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+    for (int t = 0; t < slices; ++t)
+      for (std::size_t c = bound(t); c < bound(t + 1); ++c) {
+        const std::uint32_t first = runs_[cell_runs_[c].begin].begin;
+        for (std::uint32_t r = cell_runs_[c].begin; r < cell_runs_[c].end; ++r)
+          observation_runs_[next[t][runs_[r].observation]++] = {static_cast<std::uint32_t>(c), runs_[r].begin - first,
+                                                                 runs_[r].end - runs_[r].begin};
+      }
   }
 
   /// One merge-like sweep over the sorted cells per column offset: as the
