@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <iterator>
-#include <thread>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <sstream>
+#include <system_error>
+#include <thread>
 
 namespace obsgroup::io {
 
@@ -260,11 +261,18 @@ std::vector<ParsedSlice> parseSlices(const NumberedLines& lines, const std::stri
                                      unsigned threads) {
   const std::size_t count = std::max<std::size_t>(1, std::min<std::size_t>(threads, lines.size()));
   std::vector<ParsedSlice> slices(count);
-  const auto bound = [&](std::size_t t) { return lines.size() * t / count; };
+  const auto parse = [&](std::size_t t) {
+    parseSlice(lines, lines.size() * t / count, lines.size() * (t + 1) / count, path, source, slices[t]);
+  };
   std::vector<std::thread> workers;
-  for (std::size_t t = 1; t < count; ++t)
-    workers.emplace_back([&, t] { parseSlice(lines, bound(t), bound(t + 1), path, source, slices[t]); });
-  parseSlice(lines, bound(0), bound(1), path, source, slices[0]);
+  std::size_t on_workers = 1;  // slices [1, on_workers) have a thread
+  try {
+    for (; on_workers < count; ++on_workers) workers.emplace_back(parse, on_workers);
+  } catch (const std::system_error&) {
+    // No more threads to be had: this thread parses the rest.
+  }
+  for (std::size_t t = on_workers; t < count; ++t) parse(t);
+  parse(0);
   for (auto& worker : workers) worker.join();
   return slices;
 }
@@ -320,7 +328,7 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
 
   // Second pass: parse the chosen messages, slices of lines in parallel,
   // and then the PARAM lines in order.
-  const std::vector<ParsedSlice> slices = parseSlices(lines, path, log.source, threadsFor(content.size(), options));
+  std::vector<ParsedSlice> slices = parseSlices(lines, path, log.source, threadsFor(content.size(), options));
   LaserParams params;
   Failure first_failure;
   for (const ParsedSlice& slice : slices) {
@@ -339,7 +347,7 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
     }
   }
   if (first_failure.error) std::rethrow_exception(first_failure.error);
-  for (const ParsedSlice& slice : slices)
+  for (ParsedSlice& slice : slices)
     log.scans.insert(log.scans.end(), std::make_move_iterator(slice.scans.begin()),
                      std::make_move_iterator(slice.scans.end()));
   for (LaserScan& scan : log.scans) {
