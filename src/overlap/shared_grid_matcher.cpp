@@ -354,22 +354,27 @@ struct CellMatches {
   std::size_t words(std::size_t cell) const { return (near_offsets[cell + 1] - near_offsets[cell] + 63) / 64; }
 };
 
+/// Squared float distance from p to point q of the neighbourhood's arrays;
+/// planar data (every z the same) skips z.
+template <bool Planar>
+inline float squaredDistance(const Eigen::Vector3f& p, const float* x, const float* y, const float* z, std::uint32_t q) {
+  const float dx = p.x() - x[q], dy = p.y() - y[q];
+  const float d = dx * dx + dy * dy;
+  if (Planar) return d;
+  const float dz = p.z() - z[q];
+  return d + dz * dz;
+}
+
 /// The float test of MatchDistance, written so that the compiler vectorises
 /// it; `border` tells whether some distance fell in the band where only the
-/// double test may decide. Planar data (every z the same) skips z.
+/// double test may decide.
 template <bool Planar>
 std::uint8_t floatMatches(const Eigen::Vector3f& p, float inside, float outside, const float* __restrict x,
                           const float* __restrict y, const float* __restrict z, std::uint8_t* __restrict hit,
                           std::uint32_t begin, std::uint32_t end) {
-  const float px = p.x(), py = p.y(), pz = p.z();
   std::uint8_t border = 0;
   for (std::uint32_t q = begin; q < end; ++q) {
-    const float dx = px - x[q], dy = py - y[q];
-    float d = dx * dx + dy * dy;
-    if (!Planar) {
-      const float dz = pz - z[q];
-      d += dz * dz;
-    }
+    const float d = squaredDistance<Planar>(p, x, y, z, q);
     hit[q] = d < inside;
     border |= (d >= inside) & (d <= outside);
   }
@@ -386,15 +391,9 @@ std::uint64_t floatMatchBits(const Eigen::Vector3f& p, float inside, float outsi
                              const float* __restrict y, const float* __restrict z,
                              const std::uint32_t* __restrict low_bit, const std::uint32_t* __restrict high_bit,
                              std::uint32_t begin, std::uint32_t end, std::uint8_t& border) {
-  const float px = p.x(), py = p.y(), pz = p.z();
   std::uint32_t low = 0, high = 0, band = 0;
   for (std::uint32_t q = begin; q < end; ++q) {
-    const float dx = px - x[q], dy = py - y[q];
-    float d = dx * dx + dy * dy;
-    if (!Planar) {
-      const float dz = pz - z[q];
-      d += dz * dz;
-    }
+    const float d = squaredDistance<Planar>(p, x, y, z, q);
     const std::uint32_t hit = std::uint32_t(0) - std::uint32_t(d < inside);
     low |= low_bit[q] & hit;
     high |= high_bit[q] & hit;
