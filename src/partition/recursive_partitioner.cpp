@@ -46,8 +46,8 @@ struct Decision {
 /// graph (AMD's, or the user's), or nothing when no sparse solve can happen.
 /// Restricted to a subgraph it keeps a low fill: a subgraph of a route is a
 /// stretch of it, eliminated in the order of the whole. One ordering serves
-/// every node of the split tree (an AMD ordering per subgraph cost about
-/// half of each factorisation).
+/// every node of the split tree (an AMD ordering of its own cost a subgraph
+/// more than its numeric factorisation).
 std::vector<int> eliminationRanks(const WeightMatrix& W, const FiedlerOptions& eigen) {
   const Eigen::Index n = W.rows();
   if (!eigen.elimination_rank.empty()) {
