@@ -178,9 +178,11 @@ TEST(Fiedler, AnyEliminationOrderGivesTheSameVector) {
   EXPECT_THROW(fiedlerVector(W, wrong), std::invalid_argument);
 }
 
-TEST(Fiedler, ThePartitionerSharesOneEliminationOrderWithEverySubgraph) {
+TEST(Fiedler, AUsersEliminationOrderGivesThePartitionOfTheSharedOne) {
   // recursivePartition orders the whole graph once and hands each subgraph its
-  // members' ranks; a user's order of the whole graph is used the same way.
+  // members' ranks; a user's order of the whole graph is used the same way and
+  // must give the same partition (the order changes the speed only), and one
+  // of the wrong length is refused.
   const WeightMatrix W = routeGraph(1500, 8, 13);
   PartitionOptions options;
   options.eigen.solver = EigenSolver::Sparse;

@@ -483,6 +483,19 @@ std::uint32_t groupNeighbourhood(const Grid& grid, std::size_t c, std::int32_t* 
   return groups;
 }
 
+/// Calls test(begin, end) on the ranges of the neighbourhood's points to
+/// test: all of them, or all but the point's own observation
+/// [own_begin, own_end) when that is large.
+template <typename Test>
+void testOthers(std::uint32_t own_begin, std::uint32_t own_end, std::uint32_t total, const Test& test) {
+  if (own_end - own_begin <= 16) {  // one loop is cheaper than skipping a few points
+    test(0, total);
+  } else {  // dense clouds: most of the neighbourhood is the point's own observation
+    test(0, own_begin);
+    test(own_end, total);
+  }
+}
+
 /// Sets, in `mask`, the groups of the neighbourhood that have a point within
 /// delta of p, its own group `self` excepted.
 template <bool Planar>
@@ -495,13 +508,10 @@ void matchPoint(const Eigen::Vector3f& p, std::uint32_t self, std::uint32_t grou
   std::uint8_t border = 0;
   if (groups <= 64) {  // the usual case: the group bits are ORed as the distances are tested
     const std::uint32_t *low = s.low_bit.data(), *high = s.high_bit.data();
-    std::uint64_t word;
-    if (own_end - own_begin <= 16) {
-      word = floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, 0, total, border);
-    } else {
-      word = floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, 0, own_begin, border);
-      word |= floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, own_end, total, border);
-    }
+    std::uint64_t word = 0;
+    testOthers(own_begin, own_end, total, [&](std::uint32_t begin, std::uint32_t end) {
+      word |= floatMatchBits<Planar>(p, inside, outside, x, y, z, low, high, begin, end, border);
+    });
     if (border) {  // rare: a distance within 1e-4 of delta, decided in double
       word = 0;
       for (std::uint32_t q = 0; q < total; ++q)
@@ -510,12 +520,9 @@ void matchPoint(const Eigen::Vector3f& p, std::uint32_t self, std::uint32_t grou
     mask[0] = word & ~(std::uint64_t(1) << self);
     return;
   }
-  if (own_end - own_begin <= 16) {  // one loop is cheaper than skipping a few points
-    border = floatMatches<Planar>(p, inside, outside, x, y, z, hit, 0, total);
-  } else {  // dense clouds: most of the neighbourhood is the point's own observation
-    border = floatMatches<Planar>(p, inside, outside, x, y, z, hit, 0, own_begin);
-    border |= floatMatches<Planar>(p, inside, outside, x, y, z, hit, own_end, total);
-  }
+  testOthers(own_begin, own_end, total, [&](std::uint32_t begin, std::uint32_t end) {
+    border |= floatMatches<Planar>(p, inside, outside, x, y, z, hit, begin, end);
+  });
   if (border) {  // rare: a distance within 1e-4 of delta, decided in double
     for (std::uint32_t q = 0; q < total; ++q) hit[q] = within(p, Eigen::Vector3f(x[q], y[q], z[q]));
   }
