@@ -50,6 +50,10 @@ class ObservationGrouping {
   void clear();
 
   // --- sensed-space overlap (sec. IV-A) ---
+  void setSensedSpaceModel(SensedSpaceModel model) { overlap_.setSensedSpaceModel(model); }
+  SensedSpaceModel getSensedSpaceModel() const { return overlap_.getSensedSpaceModel(); }
+  void setRegionParameters(const RegionParameters& params) { overlap_.setRegionParameters(params); }
+  const RegionParameters& getRegionParameters() const { return overlap_.getRegionParameters(); }
   void setMatchDistance(double delta) { overlap_.setMatchDistance(delta); }
   double getMatchDistance() const { return overlap_.getMatchDistance(); }
   void setVoxelLeafSize(double leaf) { overlap_.setVoxelLeafSize(leaf); }

@@ -34,7 +34,7 @@ void catchInterrupts() {
 }
 
 void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, double& fov, double& max_range,
-                         std::string& poses, int& max_depth, double& map_voxel) {
+                         std::string& poses, int& max_depth, double& map_voxel, std::vector<double>& band) {
   using obsgroup::SplitCriterion;
   using obsgroup::io::LaserSource;
   using obsgroup::io::PoseFormat;
@@ -62,7 +62,38 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->transform(CLI::CheckedTransformer(formats))
       ->group("PCD sequences");
 
-  command.add_option("--delta", args.delta, "match distance of eq. (16), metres")
+  const std::map<std::string, obsgroup::SensedSpaceModel> models{
+      {"points", obsgroup::SensedSpaceModel::Points},
+      {"free-space", obsgroup::SensedSpaceModel::FreeSpace},
+      {"visibility", obsgroup::SensedSpaceModel::Visibility}};
+  command.add_option("--sso", args.sso,
+                     "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "
+                     "visibility (cells visible from the pose)")
+      ->transform(CLI::CheckedTransformer(models))
+      ->group("Method");
+  command.add_option("--cell", args.region.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--range", args.region.max_range, "free-space, visibility: how far from the sensor, metres")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--clearance", args.region.clearance,
+                     "visibility: occupied cells nearer the pose than this do not block, metres")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--min-observations", args.region.min_observations,
+                     "visibility: a cell is occupied when this many observations have a point in it")
+      ->check(CLI::Range(1, 1 << 30))
+      ->capture_default_str()
+      ->group("Method");
+  command.add_option("--band", band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
+                                     "LOW HIGH metres")
+      ->expected(2)
+      ->group("Method");
+  command.add_option("--delta", args.delta, "points: match distance of eq. (16), metres")
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group("Method");
@@ -114,8 +145,9 @@ int main(int argc, char** argv) {
   double fov = 0.0, max_range = 0.0, map_voxel = 0.0;
   std::string poses;
   int max_depth = 0;
+  std::vector<double> band;
   CLI::App* partition = app.add_subcommand("partition", "group the observations of a log or a PCD sequence");
-  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel);
+  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel, band);
 
   try {
     app.parse(argc, argv);
@@ -130,6 +162,14 @@ int main(int argc, char** argv) {
   if (partition->count("--poses")) args.poses = poses;
   if (partition->count("--max-depth")) args.max_depth = max_depth;
   if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
+  if (partition->count("--band")) {
+    if (!(band[0] < band[1])) {
+      std::fprintf(stderr, "obsgroup: error: --band: LOW must be below HIGH (got %g %g)\n", band[0], band[1]);
+      return 2;
+    }
+    args.region.band_low = band[0];
+    args.region.band_high = band[1];
+  }
 
   args.interrupt = &interrupt_requested;
   catchInterrupts();

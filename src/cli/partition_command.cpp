@@ -81,6 +81,8 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   ObservationGrouping<PointT> grouping;
   grouping.setInterruptFlag(args.interrupt);
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  grouping.setSensedSpaceModel(args.sso);
+  grouping.setRegionParameters(args.region);
   grouping.setMatchDistance(args.delta);
   grouping.setVoxelLeafSize(args.voxel);
   grouping.setNcutThreshold(args.ncut_threshold);
@@ -150,14 +152,25 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   run.input = args.input;
   run.parameters = input.parameters;
   run.parameters["format"] = input.format;
-  run.parameters["delta"] = args.delta;
+  run.parameters["sso"] = toString(args.sso);
+  if (args.sso == SensedSpaceModel::Points) {
+    run.parameters["delta"] = args.delta;
+  } else {
+    run.parameters["cell"] = args.region.cell_size;
+    run.parameters["range"] = args.region.max_range;
+    if (args.sso == SensedSpaceModel::Visibility) {
+      run.parameters["clearance"] = args.region.clearance;
+      run.parameters["min_observations"] = args.region.min_observations;
+      run.parameters["band"] = {args.region.band_low, args.region.band_high};
+    }
+  }
   run.parameters["voxel"] = args.voxel;
   run.parameters["ncut_threshold"] = args.ncut_threshold;
   run.parameters["split"] = toString(args.split);
   run.parameters["min_group_size"] = args.min_group_size;
   run.parameters["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
   run.parameters["diagonal"] = grouping.getDiagonalWeight();
-  run.parameters["neighbour_search"] = "shared_grid";
+  if (args.sso == SensedSpaceModel::Points) run.parameters["neighbour_search"] = "shared_grid";
   run.parameters["map_voxel"] = map_voxel;
   run.parameters["refine"] = toString(args.refine);
   run.statistics = {{"points", points},

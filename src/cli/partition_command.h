@@ -6,6 +6,7 @@
 #include "pose_file.h"
 
 #include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/overlap/sensed_regions.h>
 #include <obsgroup/spectral/spectral_bisection.h>
 
 #include <optional>
@@ -25,6 +26,8 @@ struct PartitionArgs {
   std::optional<std::string> poses;
   io::PoseFormat pose_format = io::PoseFormat::Tum;
   // the method
+  SensedSpaceModel sso = SensedSpaceModel::Points;
+  RegionParameters region;  ///< free-space and visibility models
   double delta = 0.1;
   double voxel = 0.0;
   double ncut_threshold = 1.0;

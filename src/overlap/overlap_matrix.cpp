@@ -6,14 +6,19 @@
 namespace obsgroup {
 
 OverlapResult assembleOverlap(const MatchCounts& counts, const WorldPoints& world) {
-  const int n = world.size();
+  std::vector<std::size_t> sizes(world.size());
+  for (int i = 0; i < world.size(); ++i) sizes[i] = world.count(i);
+  return assembleOverlap(counts, sizes);
+}
+
+OverlapResult assembleOverlap(const MatchCounts& counts, const std::vector<std::size_t>& sizes) {
+  const int n = static_cast<int>(sizes.size());
   if (static_cast<int>(counts.rows.size()) != n)
     throw std::invalid_argument("assembleOverlap: one row of counts per observation expected");
   OverlapResult out;
   out.pairs_evaluated = counts.pairs_evaluated;
   out.point_tests = counts.point_tests;
-  out.points_per_observation.resize(n);
-  for (int i = 0; i < n; ++i) out.points_per_observation[i] = world.count(i);
+  out.points_per_observation = sizes;
 
   // Pi row by row, eq. (17): the rows arrive sorted by j, so the compressed
   // storage is filled directly.
@@ -29,7 +34,7 @@ OverlapResult assembleOverlap(const MatchCounts& counts, const WorldPoints& worl
       if (m.j <= previous || m.j >= n || m.j == i || m.count == 0)
         throw std::invalid_argument("assembleOverlap: each row must list distinct j != i, ascending, with count > 0");
       previous = m.j;
-      out.match_ratio.insertBack(i, m.j) = double(m.count) / double(world.count(i));
+      out.match_ratio.insertBack(i, m.j) = double(m.count) / double(sizes[i]);
     }
   }
   out.match_ratio.finalize();

@@ -36,7 +36,10 @@ struct OverlapResult {
   Eigen::SparseMatrix<double, Eigen::RowMajor> match_ratio;
   /// Psi(n_i, n_j) = (Pi_ij + Pi_ji) / 2, eq. (18), for each pair i < j with Psi > 0.
   std::vector<WeightedPair> pairs;
-  std::vector<std::size_t> points_per_observation;  ///< M of eq. (17), after filtering.
+  std::vector<std::size_t> points_per_observation;  ///< Points of each observation, after filtering (M of eq. 17 for points).
+  /// Cells of each observation's region (M of Pi for the region models;
+  /// empty for points).
+  std::vector<std::size_t> region_cells;
   std::uint64_t pairs_evaluated = 0;
   std::uint64_t point_tests = 0;
 };
@@ -44,5 +47,9 @@ struct OverlapResult {
 /// Divides the counts by M (eq. 17) and symmetrises them (eq. 18).
 /// An observation without points matches nothing: its Pi row is 0.
 OverlapResult assembleOverlap(const MatchCounts& counts, const WorldPoints& world);
+/// The same with M of eq. (17) given per observation: its points, or its
+/// cells for the region models (sensed_regions.h). points_per_observation
+/// is set to `sizes`.
+OverlapResult assembleOverlap(const MatchCounts& counts, const std::vector<std::size_t>& sizes);
 
 }  // namespace obsgroup

@@ -6,6 +6,7 @@
 #include "obsgroup/interrupt.h"
 #include "obsgroup/observation.h"
 #include "obsgroup/overlap/overlap_matrix.h"
+#include "obsgroup/overlap/sensed_regions.h"
 #include "obsgroup/overlap/world_points.h"
 
 #include <pcl/search/search.h>
@@ -45,6 +46,14 @@ class SensedSpaceOverlap {
   /// matching, in metres; 0 (the default) disables it.
   void setVoxelLeafSize(double leaf) { voxel_leaf_ = leaf; }
   double getVoxelLeafSize() const { return voxel_leaf_; }
+
+  /// The model of the sensed space (see sensed_regions.h): the paper's
+  /// points (the default here), free space or visibility.
+  void setSensedSpaceModel(SensedSpaceModel model) { model_ = model; }
+  SensedSpaceModel getSensedSpaceModel() const { return model_; }
+  /// Cell size, range and the rest of the free-space and visibility models.
+  void setRegionParameters(const RegionParameters& params) { region_ = params; }
+  const RegionParameters& getRegionParameters() const { return region_; }
 
   void setNeighbourSearch(NeighbourSearch method) { neighbour_search_ = method; }
   NeighbourSearch getNeighbourSearch() const { return neighbour_search_; }
@@ -87,6 +96,8 @@ class SensedSpaceOverlap {
   MatchCounts countMatchesPclSearch(const WorldPoints& world) const;
 
   double delta_ = 0.1;
+  SensedSpaceModel model_ = SensedSpaceModel::Points;
+  RegionParameters region_;
   double voxel_leaf_ = 0.0;
   NeighbourSearch neighbour_search_ = NeighbourSearch::SharedGrid;
   SearchMethodPtr search_;

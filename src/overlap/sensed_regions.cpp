@@ -1,0 +1,499 @@
+#include "obsgroup/overlap/sensed_regions.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+
+#if defined(__GLIBCXX__) && defined(_OPENMP)
+#include <parallel/algorithm>
+#endif
+
+namespace obsgroup {
+
+std::string toString(SensedSpaceModel model) {
+  switch (model) {
+    case SensedSpaceModel::Points: return "points";
+    case SensedSpaceModel::FreeSpace: return "free-space";
+    case SensedSpaceModel::Visibility: return "visibility";
+  }
+  return "?";
+}
+
+SensedSpaceModel sensedSpaceModelFromString(const std::string& name) {
+  if (name == "points") return SensedSpaceModel::Points;
+  if (name == "free-space") return SensedSpaceModel::FreeSpace;
+  if (name == "visibility") return SensedSpaceModel::Visibility;
+  throw std::invalid_argument("unknown sensed-space model '" + name + "' (points, free-space or visibility)");
+}
+
+namespace {
+
+int threadCount(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
+
+/// Keeps the first exception of a parallel loop by index and rethrows it
+/// after the region, so that errors do not depend on the thread count.
+class FirstError {
+ public:
+  void keep(long index, std::exception_ptr e) {
+#pragma omp critical(obsgroup_regions_error)
+    if (!error_ || index < index_) error_ = e, index_ = index;
+  }
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::exception_ptr error_;
+  long index_ = std::numeric_limits<long>::max();
+};
+
+// --- cells and keys ---------------------------------------------------------
+//
+// A cell is (ix, iy) in 2D or (ix, iy, iz) in 3D, ix = floor(x / cell_size)
+// of the re-centred coordinates. Its key packs the biased indices so that
+// keys ascend in lexicographic (x, y, z) order: 32 bits per axis in 2D, 21 in 3D.
+
+constexpr std::int64_t kBias2 = std::int64_t(1) << 31;
+constexpr std::int64_t kBias3 = std::int64_t(1) << 20;
+
+template <int D>
+using Cell = std::array<std::int64_t, D>;
+
+template <int D>
+std::uint64_t keyOf(const Cell<D>& c) {
+  if constexpr (D == 2) return (std::uint64_t(c[0] + kBias2) << 32) | std::uint64_t(c[1] + kBias2);
+  else return (std::uint64_t(c[0] + kBias3) << 42) | (std::uint64_t(c[1] + kBias3) << 21) | std::uint64_t(c[2] + kBias3);
+}
+
+template <int D>
+void checkRepresentable(const Cell<D>& lo, const Cell<D>& hi) {
+  const std::int64_t limit = (D == 2 ? kBias2 : kBias3) - 2;
+  for (int a = 0; a < D; ++a)
+    if (lo[a] < -limit || hi[a] > limit)
+      throw std::invalid_argument("the map spans more cells than a region can index: raise the cell size");
+}
+
+/// The cells one observation's region covers, marked in a bitmap over its
+/// bounding box (in cells) and read back in key order; a box too large for a
+/// bitmap falls back to collecting and sorting the keys.
+template <int D>
+class RegionMarker {
+ public:
+  void reset(const Cell<D>& lo, const Cell<D>& hi) {
+    lo_ = lo;
+    std::uint64_t total = 1;
+    for (int a = 0; a < D; ++a) {
+      extent_[a] = hi[a] - lo[a] + 1;
+      total *= std::uint64_t(extent_[a]);
+    }
+    dense_ = total <= (std::uint64_t(1) << 26);
+    keys_.clear();
+    if (dense_) bits_.assign((total + 63) / 64, 0);
+  }
+  void mark(const Cell<D>& c) {
+    if (!dense_) {
+      keys_.push_back(keyOf<D>(c));
+      return;
+    }
+    const std::uint64_t b = offset(c);
+    bits_[b >> 6] |= std::uint64_t(1) << (b & 63);
+  }
+  /// Appends the marked keys, ascending.
+  void emit(std::vector<std::uint64_t>& out) {
+    if (!dense_) {
+      std::sort(keys_.begin(), keys_.end());
+      keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
+      out.insert(out.end(), keys_.begin(), keys_.end());
+      return;
+    }
+    for (std::size_t w = 0; w < bits_.size(); ++w)
+      for (std::uint64_t word = bits_[w]; word; word &= word - 1) {
+        std::uint64_t b = w * 64 + std::uint64_t(__builtin_ctzll(word));
+        Cell<D> c;
+        for (int a = D - 1; a >= 0; --a) {
+          c[a] = lo_[a] + std::int64_t(b % std::uint64_t(extent_[a]));
+          b /= std::uint64_t(extent_[a]);
+        }
+        out.push_back(keyOf<D>(c));
+      }
+  }
+
+ private:
+  std::uint64_t offset(const Cell<D>& c) const {
+    std::uint64_t b = 0;
+    for (int a = 0; a < D; ++a) b = b * std::uint64_t(extent_[a]) + std::uint64_t(c[a] - lo_[a]);
+    return b;
+  }
+  Cell<D> lo_{};
+  std::array<std::int64_t, D> extent_{};
+  bool dense_ = true;
+  std::vector<std::uint64_t> bits_;
+  std::vector<std::uint64_t> keys_;
+};
+
+/// Visits the cells a segment from `from` to `to` (in cell units) crosses, in
+/// order (Amanatides and Woo). `visit(cell, t)` gets the parameter t in [0, 1]
+/// at which the segment enters the cell and returns false to stop.
+template <int D, typename Visit>
+void traverse(const std::array<double, D>& from, const std::array<double, D>& to, Visit&& visit) {
+  Cell<D> cell, last;
+  std::array<double, D> next, step_t;
+  std::array<int, D> step;
+  std::int64_t budget = 1;
+  for (int a = 0; a < D; ++a) {
+    cell[a] = std::int64_t(std::floor(from[a]));
+    last[a] = std::int64_t(std::floor(to[a]));
+    const double d = to[a] - from[a];
+    step[a] = d > 0 ? 1 : -1;
+    step_t[a] = d != 0 ? 1.0 / std::abs(d) : std::numeric_limits<double>::infinity();
+    next[a] = d != 0 ? (double(cell[a] + (d > 0)) - from[a]) / d : std::numeric_limits<double>::infinity();
+    budget += std::abs(last[a] - cell[a]);
+  }
+  double t = 0.0;
+  // The budget (the cells between the end cells) bounds the walk whatever
+  // the rounding of `next`.
+  for (std::int64_t k = 0; k < budget; ++k) {
+    if (!visit(cell, t) || cell == last) return;
+    int axis = 0;
+    for (int a = 1; a < D; ++a)
+      if (next[a] < next[axis]) axis = a;
+    if (next[axis] > 1.0) return;
+    t = next[axis];
+    cell[axis] += step[axis];
+    next[axis] += step_t[axis];
+  }
+}
+
+template <int D>
+std::array<double, D> inCells(const Eigen::Vector3d& p, double cell) {
+  std::array<double, D> out;
+  for (int a = 0; a < D; ++a) out[a] = p[a] / cell;
+  return out;
+}
+
+template <int D>
+Cell<D> cellOf(const std::array<double, D>& p) {
+  Cell<D> c;
+  for (int a = 0; a < D; ++a) c[a] = std::int64_t(std::floor(p[a]));
+  return c;
+}
+
+/// The box of cells within `range` of `origin` (both in cell units), one
+/// cell of margin for rounding.
+template <int D>
+std::pair<Cell<D>, Cell<D>> boxAround(const std::array<double, D>& origin, double range) {
+  Cell<D> lo, hi;
+  for (int a = 0; a < D; ++a) {
+    lo[a] = std::int64_t(std::floor(origin[a] - range)) - 1;
+    hi[a] = std::int64_t(std::floor(origin[a] + range)) + 1;
+  }
+  checkRepresentable<D>(lo, hi);
+  return {lo, hi};
+}
+
+// --- free space --------------------------------------------------------------
+
+/// The cells crossed by observation i's beams, from the sensor to each point
+/// (or to max_range along it).
+template <int D>
+void freeSpaceOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin, const RegionParameters& params,
+                 RegionMarker<D>& marker, std::vector<std::uint64_t>& out) {
+  if (world.count(i) == 0) return;
+  const double s = params.cell_size, range = params.max_range / s;
+  const auto o = inCells<D>(origin, s);
+  // The box of the beams: the origin and every (clipped) end point.
+  std::vector<std::array<double, D>> ends;
+  ends.reserve(world.count(i));
+  Cell<D> lo = cellOf<D>(o), hi = lo;
+  for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+    std::array<double, D> e = inCells<D>(p->cast<double>(), s);
+    double length = 0;
+    for (int a = 0; a < D; ++a) length += (e[a] - o[a]) * (e[a] - o[a]);
+    length = std::sqrt(length);
+    if (length > range)
+      for (int a = 0; a < D; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+    const Cell<D> c = cellOf<D>(e);
+    for (int a = 0; a < D; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+    ends.push_back(e);
+  }
+  checkRepresentable<D>(lo, hi);
+  marker.reset(lo, hi);
+  for (const auto& e : ends)
+    traverse<D>(o, e, [&](const Cell<D>& c, double) {
+      marker.mark(c);
+      return true;
+    });
+  marker.emit(out);
+}
+
+// --- visibility --------------------------------------------------------------
+
+/// The occupied cells of the plane, in tiles of 64 x 64 found by hash: any
+/// extent, memory in proportion to the occupied area.
+class OccupancyGrid {
+ public:
+  explicit OccupancyGrid(const std::vector<std::uint64_t>& occupied_keys) {
+    for (std::uint64_t key : occupied_keys) {
+      const std::uint64_t ux = key >> 32, uy = key & 0xffffffffu;
+      const std::uint64_t tile = ((ux >> 6) << 32) | (uy >> 6);
+      auto [it, added] = index_.emplace(tile, std::uint32_t(tiles_.size()));
+      if (added) tiles_.emplace_back();
+      tiles_[it->second][ux & 63] |= std::uint64_t(1) << (uy & 63);
+    }
+  }
+
+  /// One ray caster per thread: it remembers the last tile it looked at.
+  class Reader {
+   public:
+    explicit Reader(const OccupancyGrid& grid) : grid_(grid) {}
+    bool occupied(const Cell<2>& c) {
+      const std::uint64_t ux = std::uint64_t(c[0] + kBias2), uy = std::uint64_t(c[1] + kBias2);
+      const std::uint64_t tile = ((ux >> 6) << 32) | (uy >> 6);
+      if (tile != last_tile_) {
+        const auto it = grid_.index_.find(tile);
+        last_ = it == grid_.index_.end() ? nullptr : &grid_.tiles_[it->second];
+        last_tile_ = tile;
+      }
+      return last_ && ((*last_)[ux & 63] >> (uy & 63) & 1);
+    }
+
+   private:
+    const OccupancyGrid& grid_;
+    std::uint64_t last_tile_ = std::numeric_limits<std::uint64_t>::max();
+    const std::array<std::uint64_t, 64>* last_ = nullptr;
+  };
+
+ private:
+  std::unordered_map<std::uint64_t, std::uint32_t> index_;
+  std::vector<std::array<std::uint64_t, 64>> tiles_;
+};
+
+/// Whether point p of an observation whose sensor is at `origin` feeds the
+/// occupancy grid: in 3D only the band about the sensor's height, so that
+/// floor and ceiling do not close the view.
+bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, const RegionParameters& params, bool planar) {
+  if (planar) return true;
+  const double height = double(p.z()) - origin.z();
+  return height >= params.band_low && height <= params.band_high;
+}
+
+/// The plane cells occupied by at least params.min_observations observations.
+std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins,
+                                         const RegionParameters& params, bool planar, int threads) {
+  const int n = world.size();
+  std::vector<std::vector<std::uint64_t>> per_observation(n);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+  for (int i = 0; i < n; ++i) {
+    auto& keys = per_observation[i];
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
+      if (inBand(*p, origins[i], params, planar))
+        keys.push_back(keyOf<2>(cellOf<2>(inCells<2>(p->cast<double>(), params.cell_size))));
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  }
+  std::vector<std::uint64_t> all;
+  for (auto& keys : per_observation) {
+    all.insert(all.end(), keys.begin(), keys.end());
+    std::vector<std::uint64_t>().swap(keys);
+  }
+#if defined(__GLIBCXX__) && defined(_OPENMP)
+  __gnu_parallel::sort(all.begin(), all.end());  // integers: the same order whatever the threads
+#else
+  std::sort(all.begin(), all.end());
+#endif
+  std::vector<std::uint64_t> occupied;
+  for (std::size_t a = 0; a < all.size();) {
+    std::size_t b = a;
+    while (b < all.size() && all[b] == all[a]) ++b;
+    if (b - a >= std::size_t(params.min_observations)) occupied.push_back(all[a]);
+    a = b;
+  }
+  return occupied;
+}
+
+/// The cells visible from observation i's position: rays all around it at a
+/// fixed set of world angles (so the heading plays no part), each stopped by
+/// the first occupied cell it enters beyond the clearance, that cell included.
+void visibilityOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin, const RegionParameters& params,
+                  OccupancyGrid::Reader& occupancy, RegionMarker<2>& marker, std::vector<std::uint64_t>& out) {
+  if (world.count(i) == 0) return;  // an observation with no point sensed nothing
+  const double s = params.cell_size, range = params.max_range / s, clear = params.clearance / params.max_range;
+  const auto o = inCells<2>(origin, s);
+  const auto [lo, hi] = boxAround<2>(o, range);
+  marker.reset(lo, hi);
+  // Adjacent rays at most one cell apart at full range.
+  const int rays = std::max(64, int(std::ceil(2.0 * 3.14159265358979323846 * range)));
+  for (int r = 0; r < rays; ++r) {
+    const double angle = 2.0 * 3.14159265358979323846 * r / rays;
+    const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
+    traverse<2>(o, end, [&](const Cell<2>& c, double t) {
+      marker.mark(c);
+      return t < clear || !occupancy.occupied(c);
+    });
+  }
+  marker.emit(out);
+}
+
+void checkParameters(const RegionParameters& p) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(p.cell_size)) throw std::invalid_argument("region cell size must be finite and > 0");
+  if (!positive(p.max_range)) throw std::invalid_argument("region range must be finite and > 0");
+  if (p.max_range / p.cell_size > 4096)
+    throw std::invalid_argument("region range is more than 4096 cells: raise the cell size or lower the range");
+  if (!(std::isfinite(p.clearance) && p.clearance >= 0)) throw std::invalid_argument("clearance must be finite and >= 0");
+  if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
+  if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
+    throw std::invalid_argument("height band must be finite with low < high");
+}
+
+/// True when every point and every sensor lies at one height: 2D data.
+bool isPlanar(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins) {
+  if (origins.empty()) return true;
+  const double z0 = origins[0].z();
+  for (const auto& o : origins)
+    if (std::abs(o.z() - z0) > 1e-3) return false;
+  for (const auto& p : world.points)
+    if (std::abs(double(p.z()) - z0) > 1e-3) return false;
+  return true;
+}
+
+}  // namespace
+
+ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& world,
+                                  const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,
+                                  int threads, const InterruptFlag* interrupt) {
+  if (model == SensedSpaceModel::Points)
+    throw std::invalid_argument("computeRegions: the points model has no regions (use SensedSpaceOverlap)");
+  checkParameters(params);
+  const int n = world.size();
+  if (static_cast<int>(sensor_origins.size()) != n)
+    throw std::invalid_argument("computeRegions: one sensor origin per observation expected");
+  for (const auto& o : sensor_origins)
+    if (!o.allFinite()) throw std::invalid_argument("computeRegions: a sensor origin is not finite");
+  threads = threadCount(threads);
+
+  ObservationRegions regions;
+  regions.planar = isPlanar(world, sensor_origins);
+  const bool volumetric = model == SensedSpaceModel::FreeSpace && !regions.planar;
+  std::vector<std::uint64_t> occupied;
+  if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, regions.planar, threads);
+  const OccupancyGrid grid(occupied);
+  std::vector<std::vector<std::uint64_t>> per_observation(n);
+  FirstError error;
+#pragma omp parallel num_threads(threads)
+  {
+    RegionMarker<2> marker2;
+    RegionMarker<3> marker3;
+    OccupancyGrid::Reader reader(grid);
+#pragma omp for schedule(dynamic, 8)
+    for (int i = 0; i < n; ++i) {
+      if (interruptRequested(interrupt)) continue;
+      try {
+        if (model == SensedSpaceModel::Visibility)
+          visibilityOf(world, i, sensor_origins[i], params, reader, marker2, per_observation[i]);
+        else if (volumetric)
+          freeSpaceOf<3>(world, i, sensor_origins[i], params, marker3, per_observation[i]);
+        else
+          freeSpaceOf<2>(world, i, sensor_origins[i], params, marker2, per_observation[i]);
+      } catch (...) {
+        error.keep(i, std::current_exception());
+      }
+    }
+  }
+  throwIfInterrupted(interrupt);
+  error.rethrow();
+  regions.planar = !volumetric;
+  for (int i = 0; i < n; ++i) regions.offsets.push_back(regions.offsets.back() + per_observation[i].size());
+  regions.cells.resize(regions.offsets.back());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    std::copy(per_observation[i].begin(), per_observation[i].end(), regions.cells.begin() + regions.offsets[i]);
+    std::vector<std::uint64_t>().swap(per_observation[i]);
+  }
+  return regions;
+}
+
+MatchCounts countSharedCells(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
+  const int n = regions.size();
+  threads = threadCount(threads);
+  // Group the (cell, observation) entries by cell: one sort of all of them.
+  struct Entry {
+    std::uint64_t key;
+    std::uint32_t observation;
+    bool operator<(const Entry& other) const {
+      return key < other.key || (key == other.key && observation < other.observation);
+    }
+  };
+  std::vector<Entry> entries(regions.cells.size());
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i)
+    for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) entries[k] = {regions.cells[k], std::uint32_t(i)};
+  throwIfInterrupted(interrupt);
+#if defined(__GLIBCXX__) && defined(_OPENMP)
+  __gnu_parallel::sort(entries.begin(), entries.end());  // distinct entries: one order whatever the threads
+#else
+  std::sort(entries.begin(), entries.end());
+#endif
+  throwIfInterrupted(interrupt);
+
+  // Cell c holds the observations watchers[cell_start[c], cell_start[c+1]);
+  // observation i's cells, ascending, are cells_of[regions.offsets[i], ...).
+  std::vector<std::size_t> cell_start;
+  std::vector<std::uint32_t> watchers(entries.size());
+  std::vector<std::uint32_t> cells_of(entries.size());
+  std::vector<std::size_t> fill(regions.offsets.begin(), regions.offsets.end() - 1);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    if (k == 0 || entries[k].key != entries[k - 1].key) cell_start.push_back(k);
+    watchers[k] = entries[k].observation;
+    cells_of[fill[entries[k].observation]++] = std::uint32_t(cell_start.size() - 1);
+  }
+  cell_start.push_back(entries.size());
+  std::vector<Entry>().swap(entries);
+
+  MatchCounts out;
+  out.rows.resize(n);
+  std::uint64_t pairs = 0, tests = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : pairs, tests)
+  {
+    std::vector<std::uint32_t> shared(n, 0);
+    std::vector<int> touched;
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      if (interruptRequested(interrupt)) continue;
+      for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
+        const std::uint32_t c = cells_of[k];
+        for (std::size_t w = cell_start[c]; w < cell_start[c + 1]; ++w) {
+          const std::uint32_t j = watchers[w];
+          if (shared[j]++ == 0) touched.push_back(int(j));
+        }
+        tests += cell_start[c + 1] - cell_start[c];
+      }
+      std::sort(touched.begin(), touched.end());
+      auto& row = out.rows[i];
+      for (int j : touched) {
+        if (j != i) row.push_back({j, shared[j]});
+        shared[j] = 0;
+      }
+      pairs += row.size();
+      touched.clear();
+    }
+  }
+  throwIfInterrupted(interrupt);
+  out.pairs_evaluated = pairs;
+  out.point_tests = tests;
+  return out;
+}
+
+OverlapResult regionOverlap(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
+  std::vector<std::size_t> sizes(regions.size());
+  for (int i = 0; i < regions.size(); ++i) sizes[i] = regions.count(i);
+  return assembleOverlap(countSharedCells(regions, threads, interrupt), sizes);
+}
+
+}  // namespace obsgroup
