@@ -94,9 +94,14 @@ nlohmann::json expectPartitionSchema(const fs::path& out, std::size_t observatio
     for (const char* key : {"id", "parent", "depth", "kind", "outcome", "accepted", "ncut", "members", "children"})
       EXPECT_TRUE(s.contains(key)) << key;
   }
-  for (const char* key : {"delta", "voxel", "ncut_threshold", "split", "min_group_size", "max_depth", "diagonal",
+  for (const char* key : {"sso", "voxel", "ncut_threshold", "split", "min_group_size", "max_depth", "diagonal",
                           "format", "map_voxel"})
     EXPECT_TRUE(p.at("parameters").contains(key)) << key;
+  // Each model's own parameters, and only those.
+  const bool points = p.at("parameters").at("sso") == "points";
+  EXPECT_EQ(p.at("parameters").contains("delta"), points);
+  EXPECT_EQ(p.at("parameters").contains("cell"), !points);
+  EXPECT_EQ(p.at("parameters").contains("range"), !points);
   EXPECT_TRUE(p.at("input").is_string());
   for (const char* key : {"load", "overlap", "graph", "partition", "outputs"})
     EXPECT_TRUE(p.at("timing_s").at(key).is_number()) << key;
@@ -499,11 +504,11 @@ TEST_F(Cli, ExistingResultsAreNotOverwrittenWithoutForce) {
   ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + out).code, 0);
   const std::string before = readFile(dir_ / "out" / "partition.json");
   writeFile(dir_ / "out" / "local_maps" / "group_999.pcd", "stale");
-  const Result refused = run("partition " + input + " --delta 0.2 -q -o " + out);
+  const Result refused = run("partition " + input + " --paper --delta 0.2 -q -o " + out);
   EXPECT_EQ(refused.code, 2);
   EXPECT_NE(refused.err.find("already holds results"), std::string::npos) << refused.err;
   EXPECT_EQ(readFile(dir_ / "out" / "partition.json"), before);
-  ASSERT_EQ(run("partition " + input + " --delta 0.2 -q --no-pictures --force -o " + out).code, 0);
+  ASSERT_EQ(run("partition " + input + " --paper --delta 0.2 -q --no-pictures --force -o " + out).code, 0);
   EXPECT_EQ(readJson(dir_ / "out" / "partition.json").at("parameters").at("delta"), 0.2);
   EXPECT_FALSE(fs::exists(dir_ / "out" / "local_maps" / "group_999.pcd"));
 }
@@ -615,7 +620,7 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
   bool saw_interrupted = false, saw_completed = false;
   for (int ms = 0; ms <= 1500 && !saw_completed; ms += 30) {
     const int code = runInterruptedAfter(
-        {"partition", input, "--delta", "0.2", "--force", "--threads", "1", "-o", out.string()},
+        {"partition", input, "--paper", "--delta", "0.2", "--force", "--threads", "1", "-o", out.string()},
         std::chrono::milliseconds(ms));
     ASSERT_TRUE(code == 130 || code == 0 || code == -SIGINT) << "exit code " << code << " at " << ms << " ms";
     const auto now = snapshot(out);
@@ -720,7 +725,35 @@ TEST_F(Cli, AScanFarFromTheOthersIsNamedByItsLine) {
   writeFile(dir_ / "far.clf", log);
   const Result r = run("partition " + (dir_ / "far.clf").string() + " -q -o " + (dir_ / "o").string());
   EXPECT_EQ(r.code, 3);
-  EXPECT_NE(r.err.find("far.clf:3: observation 2: shared grid: a point lies too far"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("far.clf:3: observation 2: region grid: a point lies too far"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+  const Result paper = run("partition " + (dir_ / "far.clf").string() + " --paper -q -o " + (dir_ / "o").string());
+  EXPECT_EQ(paper.code, 3);
+  EXPECT_NE(paper.err.find("far.clf:3: observation 2: shared grid: a point lies too far"), std::string::npos)
+      << paper.err;
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 
+
+TEST_F(Cli, ThePaperPresetGivesThePapersGroups) {
+  // tests/expected/paper_groups.json holds the groups of the paper's method
+  // (points model, eq. 16-18; mean split, sec. II-A) as obsgroup computed
+  // them before the region models existed, checked then against an
+  // independent implementation; --paper and its spelled-out options keep them.
+  const nlohmann::json expected = readJson(fs::path(kData).parent_path() / "tests" / "expected" / "paper_groups.json");
+  const std::vector<std::pair<std::string, std::string>> inputs{
+      {"office_2d", "/office_2d/office.clf"},
+      {"office_3d", "/office_3d/pcd"},
+      {"localization_demo", "/real/localization_demo/localization_demo.clf"},
+      {"sena_odometry", "/real/sena_odometry/sena_odometry.clf"}};
+  for (const auto& [name, path] : inputs) {
+    for (const char* preset : {" --paper", " --sso points --split mean"}) {
+      const fs::path out = dir_ / name;
+      ASSERT_EQ(run("partition " + kData + path + preset + " --force -q --no-pictures -o " + out.string()).code, 0);
+      EXPECT_EQ(readJson(out / "partition.json").at("groups"), expected.at(name)) << name << preset;
+    }
+  }
+  // The measured defaults are not the paper's: on the depth camera they keep rooms the points model breaks.
+  ASSERT_EQ(run("partition " + kData + "/office_3d/pcd --force -q --no-pictures -o " + (dir_ / "d").string()).code, 0);
+  EXPECT_LT(readJson(dir_ / "d" / "partition.json").at("groups").size(), expected.at("office_3d").size());
+}

@@ -13,6 +13,11 @@ TEST(ObservationGrouping, ParametersRoundTrip) {
   EXPECT_DOUBLE_EQ(g.getVoxelLeafSize(), 0.0);
   EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 1.0);
   EXPECT_DOUBLE_EQ(g.getDiagonalWeight(), 0.0);
+  // The measured defaults (docs/grouping.md), and the paper's on request.
+  EXPECT_EQ(g.getSensedSpaceModel(), SensedSpaceModel::Visibility);
+  EXPECT_EQ(g.getSplitCriterion(), SplitCriterion::BestNcut);
+  g.usePaperMethod();
+  EXPECT_EQ(g.getSensedSpaceModel(), SensedSpaceModel::Points);
   EXPECT_EQ(g.getSplitCriterion(), SplitCriterion::Mean);
   EXPECT_EQ(g.getMinGroupSize(), 1);
   EXPECT_EQ(g.getNeighbourSearch(), NeighbourSearch::SharedGrid);

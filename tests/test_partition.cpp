@@ -159,6 +159,7 @@ TEST(RecursivePartition, RealOfficeLogRefinesMrptsGroups) {
     for (int i : mrpt[g]) mrpt_group.at(i) = static_cast<int>(g);
 
   ObservationGrouping<pcl::PointXYZ> grouping;
+  grouping.usePaperMethod();  // MRPT implements the paper's points model and mean split
   grouping.setMatchDistance(0.2);
   const Partition p = groupScans(grouping, obs);
   expectWellFormed(p, 72);

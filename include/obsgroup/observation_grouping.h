@@ -22,13 +22,14 @@ struct GroupingTimings {
 };
 
 /// Groups observations into consistent local maps (Blanco, Gonzalez,
-/// Fernandez-Madrigal, ICRA 2006): W_ij = Psi(n_i, n_j) (eq. 18), then
-/// recursive spectral bisection by minimum normalized cut (sec. II).
+/// Fernandez-Madrigal, ICRA 2006): W_ij = Psi(n_i, n_j) (eq. 18) of the
+/// sensed-space model set (sensed_regions.h), then recursive spectral
+/// bisection by minimum normalized cut (sec. II).
 ///
 /// \code
 ///   obsgroup::ObservationGrouping<pcl::PointXYZ> grouping;
 ///   for (const auto& [cloud, pose] : scans) grouping.addObservation(cloud, pose);
-///   grouping.setMatchDistance(0.1);
+///   grouping.setSensedSpaceModel(obsgroup::SensedSpaceModel::Visibility);  // the default
 ///   const obsgroup::Partition partition = grouping.compute();
 /// \endcode
 template <typename PointT>
@@ -39,6 +40,21 @@ class ObservationGrouping {
   using PointCloud = pcl::PointCloud<PointT>;
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
   using SearchMethodPtr = typename SensedSpaceOverlap<PointT>::SearchMethodPtr;
+
+  /// The defaults measure best across 2D lasers (360 and 180 degrees) and
+  /// depth cameras with drifted poses (docs/grouping.md): the visibility
+  /// model with the best-Ncut split. usePaperMethod() gives the paper's.
+  ObservationGrouping() {
+    overlap_.setSensedSpaceModel(SensedSpaceModel::Visibility);
+    options_.split = SplitCriterion::BestNcut;
+  }
+
+  /// The paper's method exactly: the points model of eq. (16)-(18) and the
+  /// mean split of sec. II-A (delta and the Ncut threshold as set).
+  void usePaperMethod() {
+    overlap_.setSensedSpaceModel(SensedSpaceModel::Points);
+    options_.split = SplitCriterion::Mean;
+  }
 
   /// Adds an observation: points in the sensor frame and the sensor's pose.
   void addObservation(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose);

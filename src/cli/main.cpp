@@ -34,7 +34,7 @@ void catchInterrupts() {
 }
 
 void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, double& fov, double& max_range,
-                         std::string& poses, int& max_depth, double& map_voxel, std::vector<double>& band) {
+                         std::string& poses, int& max_depth, double& map_voxel, std::vector<double>& band, bool& paper) {
   using obsgroup::SplitCriterion;
   using obsgroup::io::LaserSource;
   using obsgroup::io::PoseFormat;
@@ -68,8 +68,11 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       {"visibility", obsgroup::SensedSpaceModel::Visibility}};
   command.add_option("--sso", args.sso,
                      "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "
-                     "visibility (cells visible from the pose)")
+                     "visibility (cells visible from the pose; the default)")
       ->transform(CLI::CheckedTransformer(models))
+      ->group("Method");
+  command.add_flag("--paper", paper,
+                   "the paper's method exactly: --sso points --split mean (delta, threshold as given)")
       ->group("Method");
   command.add_option("--cell", args.region.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(CLI::PositiveNumber)
@@ -107,7 +110,7 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->group("Method");
   const std::map<std::string, SplitCriterion> splits{
       {"mean", SplitCriterion::Mean}, {"sign", SplitCriterion::Sign}, {"best", SplitCriterion::BestNcut}};
-  command.add_option("--split", args.split, "how the eigenvector is cut: mean (the paper's), sign or best")
+  command.add_option("--split", args.split, "how the eigenvector is cut: best (smallest Ncut; the default), mean (the paper's) or sign")
       ->transform(CLI::CheckedTransformer(splits))
       ->group("Method");
   command.add_option("--min-group-size", args.min_group_size, "reject a bisection giving a smaller group")
@@ -146,8 +149,9 @@ int main(int argc, char** argv) {
   std::string poses;
   int max_depth = 0;
   std::vector<double> band;
+  bool paper = false;
   CLI::App* partition = app.add_subcommand("partition", "group the observations of a log or a PCD sequence");
-  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel, band);
+  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel, band, paper);
 
   try {
     app.parse(argc, argv);
@@ -162,6 +166,28 @@ int main(int argc, char** argv) {
   if (partition->count("--poses")) args.poses = poses;
   if (partition->count("--max-depth")) args.max_depth = max_depth;
   if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
+  // Options of one model given with another are a mistake, not a no-op.
+  const auto usage = [](const std::string& message) {
+    std::fprintf(stderr, "obsgroup: error: %s\n", message.c_str());
+    return 2;
+  };
+  if (paper) {
+    if (partition->count("--sso") && args.sso != obsgroup::SensedSpaceModel::Points)
+      return usage("--paper uses --sso points; drop one of them");
+    if (partition->count("--split") && args.split != obsgroup::SplitCriterion::Mean)
+      return usage("--paper uses --split mean; drop one of them");
+    args.sso = obsgroup::SensedSpaceModel::Points;
+    args.split = obsgroup::SplitCriterion::Mean;
+  }
+  const bool points = args.sso == obsgroup::SensedSpaceModel::Points;
+  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})
+    if (points && partition->count(option))
+      return usage(std::string(option) + " applies to --sso free-space or visibility, not points");
+  if (!points && partition->count("--delta"))
+    return usage("--delta applies to --sso points (the region models use --cell)");
+  if (args.sso == obsgroup::SensedSpaceModel::FreeSpace)
+    for (const char* option : {"--clearance", "--min-observations", "--band"})
+      if (partition->count(option)) return usage(std::string(option) + " applies to --sso visibility only");
   if (partition->count("--band")) {
     if (!(band[0] < band[1])) {
       std::fprintf(stderr, "obsgroup: error: --band: LOW must be below HIGH (got %g %g)\n", band[0], band[1]);

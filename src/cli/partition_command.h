@@ -26,12 +26,15 @@ struct PartitionArgs {
   std::optional<std::string> poses;
   io::PoseFormat pose_format = io::PoseFormat::Tum;
   // the method
-  SensedSpaceModel sso = SensedSpaceModel::Points;
+  /// The defaults are the settings that measured best across lasers and
+  /// depth cameras with drifted poses (docs/grouping.md); `--paper` gives the
+  /// paper's (points, mean split).
+  SensedSpaceModel sso = SensedSpaceModel::Visibility;
   RegionParameters region;  ///< free-space and visibility models
   double delta = 0.1;
   double voxel = 0.0;
   double ncut_threshold = 1.0;
-  SplitCriterion split = SplitCriterion::Mean;
+  SplitCriterion split = SplitCriterion::BestNcut;
   int min_group_size = 1;
   std::optional<int> max_depth;
   int threads = 0;

@@ -1,5 +1,7 @@
 #include "obsgroup/overlap/sensed_regions.h"
 
+#include "obsgroup/invalid_observation.h"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -363,6 +365,27 @@ bool isPlanar(const WorldPoints& world, const std::vector<Eigen::Vector3d>& orig
   return true;
 }
 
+/// Refuses, naming the first observation, data whose cell indices would not
+/// fit a key: a corrupt pose far from the others, never a wrapped index.
+void checkReach(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins, const RegionParameters& params,
+                bool volumetric) {
+  const double limit =
+      double((volumetric ? kBias3 : kBias2) - 4) - std::ceil(params.max_range / params.cell_size);
+  const auto within = [&](const Eigen::Vector3d& p) {
+    const int axes = volumetric ? 3 : 2;
+    for (int a = 0; a < axes; ++a)
+      if (!(std::abs(p[a] / params.cell_size) < limit)) return false;
+    return true;
+  };
+  for (int i = 0; i < world.size(); ++i) {
+    const bool ok = within(origins[i]) && (world.boxes[i].isEmpty() || (within(world.boxes[i].min().cast<double>()) &&
+                                                                        within(world.boxes[i].max().cast<double>())));
+    if (!ok)
+      throw InvalidObservation(i, "region grid: a point lies too far from the first observation for " +
+                                      std::to_string(params.cell_size) + " m cells (raise --cell)");
+  }
+}
+
 }  // namespace
 
 ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& world,
@@ -381,6 +404,7 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   ObservationRegions regions;
   regions.planar = isPlanar(world, sensor_origins);
   const bool volumetric = model == SensedSpaceModel::FreeSpace && !regions.planar;
+  checkReach(world, sensor_origins, params, volumetric);
   std::vector<std::uint64_t> occupied;
   if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, regions.planar, threads);
   const OccupancyGrid grid(occupied);
