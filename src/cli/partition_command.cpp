@@ -139,7 +139,16 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
     SensedSpaceOverlap<PointT> world_frame;
     world_frame.setVoxelLeafSize(args.voxel);
     world_frame.setNumberOfThreads(args.threads);
-    io::writeMapPictures(out, world_frame.toWorld(observations), poses, partition, topology);
+    world_frame.setSensedSpaceModel(args.sso);
+    world_frame.setRegionParameters(args.region);
+    const WorldPoints world = world_frame.toWorld(observations);
+    ObservationRegions regions;
+    io::RegionTint tint;
+    if (args.sso != SensedSpaceModel::Points) {
+      regions = world_frame.computeRegions(observations, world);
+      tint = {&regions, args.region.cell_size};
+    }
+    io::writeMapPictures(out, world, poses, partition, topology, tint);
     io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
     io::writeFiedlerPicture(out, partition);
   }

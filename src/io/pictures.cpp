@@ -77,17 +77,56 @@ View fitView(const WorldPoints& world, const std::vector<Eigen::Vector2d>& posit
   return v;
 }
 
-/// The points, one pixel (or a 2x2 block when they are few) each.
-Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v) {
+std::uint32_t argbOf(const Rgb& c) {
+  return 0xff000000u | (std::uint32_t(c.r * 255) << 16) | (std::uint32_t(c.g * 255) << 8) | std::uint32_t(c.b * 255);
+}
+
+/// Each region cell in a pale shade of the group most of whose observations
+/// hold it (ties: the lower group). Cells of 3D regions are seen from above.
+void tintRegions(const RegionTint& tint, const Partition& partition, const View& v, unsigned char* data, int stride) {
+  const ObservationRegions& regions = *tint.regions;
+  std::vector<std::pair<std::uint64_t, int>> cells;  // (plane cell, group)
+  cells.reserve(regions.cells.size());
+  for (int i = 0; i < regions.size(); ++i)
+    for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
+      const Eigen::Vector3d c = regionCellCentre(regions.cells[k], regions.planar, tint.cell_size);
+      const std::uint64_t px = std::uint64_t(std::uint32_t(std::lround(v.px(c.x()))));
+      const std::uint64_t py = std::uint64_t(std::uint32_t(std::lround(v.py(c.y()))));
+      cells.emplace_back((px << 32) | py, partition.group_of[i]);
+    }
+  std::sort(cells.begin(), cells.end());
+  const int half = std::max(1, int(std::ceil(tint.cell_size * v.scale / 2)));
+  for (std::size_t a = 0; a < cells.size();) {
+    int best = -1, best_count = 0;
+    std::size_t b = a;
+    while (b < cells.size() && cells[b].first == cells[a].first) {
+      std::size_t e = b;
+      while (e < cells.size() && cells[e] == cells[b]) ++e;
+      if (int(e - b) > best_count) best = cells[b].second, best_count = int(e - b);
+      b = e;
+    }
+    const Rgb g = groupColour(best);
+    const std::uint32_t pale = argbOf({0.72 + 0.28 * g.r, 0.72 + 0.28 * g.g, 0.72 + 0.28 * g.b});
+    const int cx = int(std::int32_t(cells[a].first >> 32)), cy = int(std::int32_t(cells[a].first & 0xffffffffu));
+    for (int y = std::max(0, cy - half); y < std::min(v.height, cy + half); ++y)
+      for (int x = std::max(0, cx - half); x < std::min(v.width, cx + half); ++x)
+        reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = pale;
+    a = b;
+  }
+}
+
+/// The points, one pixel (or a 2x2 block when they are few) each, over the
+/// tinted regions when there are some.
+Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v, const RegionTint& tint) {
   Surface surface = imageSurface(v.width, v.height);
   cairo_surface_flush(surface.get());
   unsigned char* data = cairo_image_surface_get_data(surface.get());
   const int stride = cairo_image_surface_get_stride(surface.get());
+  if (tint.regions) tintRegions(tint, partition, v, data, stride);
   const int dot = world.points.size() < 300000 ? 2 : 1;
   for (int i = 0; i < world.size(); ++i) {
     const Rgb c = groupColour(partition.group_of[i]);
-    const std::uint32_t argb = 0xff000000u | (std::uint32_t(c.r * 255) << 16) | (std::uint32_t(c.g * 255) << 8) |
-                               std::uint32_t(c.b * 255);
+    const std::uint32_t argb = argbOf(c);
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
       const int x = static_cast<int>(v.px(p->x())), y = static_cast<int>(v.py(p->y()));
       for (int dy = 0; dy < dot; ++dy)
@@ -165,7 +204,7 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
 }  // namespace
 
 void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
-                      const Partition& partition, const TopologicalMap& topology) {
+                      const Partition& partition, const TopologicalMap& topology, const RegionTint& tint) {
   std::vector<Eigen::Vector2d> positions;
   std::vector<double> headings;
   for (const auto& pose : poses) {
@@ -174,7 +213,7 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const s
     headings.push_back(std::atan2(ahead.y(), ahead.x()));
   }
   const View v = fitView(world, positions);
-  const Surface points = rasterPoints(world, partition, v);
+  const Surface points = rasterPoints(world, partition, v, tint);
 
   Surface png = imageSurface(v.width, v.height);
   {

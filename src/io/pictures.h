@@ -6,6 +6,7 @@
 #include "output_folder.h"
 
 #include <obsgroup/maps/topological_map.h>
+#include <obsgroup/overlap/sensed_regions.h>
 #include <obsgroup/overlap/world_points.h>
 #include <obsgroup/partition/recursive_partitioner.h>
 
@@ -13,11 +14,19 @@
 
 namespace obsgroup::io {
 
+/// The regions of the free-space and visibility models, to tint the map with.
+struct RegionTint {
+  const ObservationRegions* regions = nullptr;
+  double cell_size = 0.0;
+};
+
 /// map.png and map.svg: every point from above coloured by its group, each
-/// pose as an arrow, and the topological arcs between group centres.
+/// pose as an arrow, and the topological arcs between group centres. With
+/// regions, each cell is first tinted with the colour of the group most of
+/// whose observations hold it: the place each group stands for.
 /// `poses` are in the same frame as `world` before re-centring.
 void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
-                      const Partition& partition, const TopologicalMap& topology);
+                      const Partition& partition, const TopologicalMap& topology, const RegionTint& tint = {});
 
 /// weights.png: W as an image, rows and columns ordered by group, darker for
 /// a larger overlap, each group boxed.

@@ -388,6 +388,16 @@ void checkReach(const WorldPoints& world, const std::vector<Eigen::Vector3d>& or
 
 }  // namespace
 
+Eigen::Vector3d regionCellCentre(std::uint64_t key, bool planar, double cell_size) {
+  if (planar)
+    return {(double(std::int64_t(key >> 32) - kBias2) + 0.5) * cell_size,
+            (double(std::int64_t(key & 0xffffffffu) - kBias2) + 0.5) * cell_size, 0.0};
+  const std::uint64_t mask = (std::uint64_t(1) << 21) - 1;
+  return {(double(std::int64_t(key >> 42) - kBias3) + 0.5) * cell_size,
+          (double(std::int64_t((key >> 21) & mask) - kBias3) + 0.5) * cell_size,
+          (double(std::int64_t(key & mask) - kBias3) + 0.5) * cell_size};
+}
+
 ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& world,
                                   const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,
                                   int threads, const InterruptFlag* interrupt) {

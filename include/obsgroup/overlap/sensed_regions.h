@@ -68,6 +68,10 @@ struct ObservationRegions {
   std::size_t count(int i) const { return offsets[i + 1] - offsets[i]; }
 };
 
+/// The centre of a region cell, in the re-centred frame of its WorldPoints
+/// (z is 0 for plane cells).
+Eigen::Vector3d regionCellCentre(std::uint64_t key, bool planar, double cell_size);
+
 /// The regions of `world`'s observations under `model` (FreeSpace or
 /// Visibility), the sensor of observation i at sensor_origins[i] (re-centred
 /// on world.origin like the points). Data whose points and origins all share

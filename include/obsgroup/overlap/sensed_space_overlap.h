@@ -87,6 +87,11 @@ class SensedSpaceOverlap {
   /// leaf too small for a cloud's extent.
   WorldPoints toWorld(const std::vector<Observation<PointT>>& observations) const;
 
+  /// The region of every observation under the free-space or visibility
+  /// model (what compute() measures the overlap of), e.g. to draw it.
+  ObservationRegions computeRegions(const std::vector<Observation<PointT>>& observations,
+                                    const WorldPoints& world) const;
+
   /// Pi and Psi for all pairs. Throws std::invalid_argument on bad parameters.
   OverlapResult compute(const std::vector<Observation<PointT>>& observations) const;
 

@@ -173,17 +173,22 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
 }
 
 template <typename PointT>
+ObservationRegions SensedSpaceOverlap<PointT>::computeRegions(const std::vector<Observation<PointT>>& observations,
+                                                              const WorldPoints& world) const {
+  // The beams start at each observation's pose, re-centred like its points.
+  std::vector<Eigen::Vector3d> origins(observations.size());
+  for (std::size_t i = 0; i < observations.size(); ++i) origins[i] = observations[i].pose.translation() - world.origin;
+  return obsgroup::computeRegions(model_, world, origins, region_, threads_, interrupt_);
+}
+
+template <typename PointT>
 OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<PointT>>& observations) const {
   if (!(delta_ > 0.0) || !std::isfinite(delta_))
     throw std::invalid_argument("match distance delta must be finite and > 0");
   const WorldPoints world = toWorld(observations);
   if (model_ != SensedSpaceModel::Points) {
-    // The beams start at each observation's pose, re-centred like its points.
-    std::vector<Eigen::Vector3d> origins(observations.size());
-    for (std::size_t i = 0; i < observations.size(); ++i) origins[i] = observations[i].pose.translation() - world.origin;
     if (progress_) progress_(0, observations.size());
-    OverlapResult result = regionOverlap(computeRegions(model_, world, origins, region_, threads_, interrupt_),
-                                         threads_, interrupt_);
+    OverlapResult result = regionOverlap(computeRegions(observations, world), threads_, interrupt_);
     result.region_cells = std::move(result.points_per_observation);
     result.points_per_observation.resize(observations.size());
     for (int i = 0; i < world.size(); ++i) result.points_per_observation[i] = world.count(i);
