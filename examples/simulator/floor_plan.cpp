@@ -102,14 +102,27 @@ double FloorPlan::castHorizontal(const Eigen::Vector2d& origin, double angle, do
   return best;
 }
 
+double LaserModel::beamAngle(std::size_t k, std::size_t count, double heading) const {
+  // Evaluated in this order, the angles are bit for bit those of the scans
+  // made before full turns existed (the committed datasets stay as they are).
+  const double step = full_turn ? field_of_view / count : count > 1 ? field_of_view / (count - 1) : 0.0;
+  return heading - field_of_view / 2 + k * step;
+}
+
+LaserModel fullTurnLaser(int beams) {
+  LaserModel laser;
+  laser.beams = beams;
+  laser.field_of_view = 2 * 3.14159265358979323846;
+  laser.full_turn = true;
+  return laser;
+}
+
 std::vector<double> FloorPlan::scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed) const {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, laser.range_noise > 0 ? laser.range_noise : 1.0);
   std::vector<double> ranges(laser.beams, laser.max_range);
-  const double step = laser.beams > 1 ? laser.field_of_view / (laser.beams - 1) : 0.0;
   for (int k = 0; k < laser.beams; ++k) {
-    const double best =
-        castHorizontal({pose.x, pose.y}, pose.yaw - laser.field_of_view / 2 + k * step, laser.max_range);
+    const double best = castHorizontal({pose.x, pose.y}, laser.beamAngle(k, laser.beams, pose.yaw), laser.max_range);
     const double n = laser.range_noise > 0 ? noise(rng) : 0.0;
     if (best < laser.max_range) ranges[k] = std::min(best + n, laser.max_range);
   }
@@ -142,6 +155,13 @@ std::vector<Eigen::Vector3d> FloorPlan::depthImage(const Pose2D& pose, const Dep
   return points;
 }
 
+double FloorPlan::clearanceAt(double x, double y, double max_distance) const {
+  double nearest = max_distance;
+  for (int degree = 0; degree < 360; ++degree)
+    nearest = std::min(nearest, castHorizontal({x, y}, degree * 3.14159265358979323846 / 180.0, max_distance));
+  return nearest;
+}
+
 int FloorPlan::roomAt(double x, double y) const {
   for (std::size_t r = 0; r < rooms_.size(); ++r)
     if (x >= rooms_[r].x0 && x <= rooms_[r].x1 && y >= rooms_[r].y0 && y <= rooms_[r].y1)
@@ -151,10 +171,9 @@ int FloorPlan::roomAt(double x, double y) const {
 
 std::vector<Eigen::Vector2d> scanToPoints(const std::vector<double>& ranges, const LaserModel& laser) {
   std::vector<Eigen::Vector2d> points;
-  const double step = ranges.size() > 1 ? laser.field_of_view / (ranges.size() - 1) : 0.0;
   for (std::size_t k = 0; k < ranges.size(); ++k) {
     if (!(ranges[k] < laser.max_range)) continue;
-    const double angle = -laser.field_of_view / 2 + k * step;
+    const double angle = laser.beamAngle(k, ranges.size());
     points.emplace_back(ranges[k] * std::cos(angle), ranges[k] * std::sin(angle));
   }
   return points;
@@ -227,10 +246,12 @@ FloorPlan office() {
   plan.addWallX(2.5, 0.0, 32.0, doors);
   for (int r = 1; r < 4; ++r) plan.addWallY(r * 8.0, 2.5, 8.5);
   // A little furniture per room and a pillar in the corridor.
-  plan.addBox(1.0, 6.5, 3.0, 7.5);
-  plan.addBox(13.0, 4.0, 14.0, 5.5);
-  plan.addBox(18.0, 6.8, 21.0, 7.6);
-  plan.addBox(29.0, 3.5, 31.0, 4.5);
+  // Furniture in the rooms' corners, out of the route's way: a robot does
+  // not drive through a cupboard.
+  plan.addBox(0.3, 7.6, 2.0, 8.3);
+  plan.addBox(14.6, 6.9, 15.6, 8.2);
+  plan.addBox(16.6, 7.7, 18.6, 8.3);
+  plan.addBox(30.8, 2.8, 31.7, 4.0);
   plan.addBox(15.8, 0.2, 16.2, 0.6);
   plan.addRoom("corridor", 0.0, 0.0, 32.0, 2.5);
   for (int r = 0; r < 4; ++r) plan.addRoom("room " + std::to_string(r + 1), r * 8.0, 2.5, r * 8.0 + 8.0, 8.5);
@@ -307,14 +328,15 @@ FloorPlan loopBuilding() {
   plan.addWallX(13.0, 3.0, 37.0);  // between the south and north rooms
   for (int r = 1; r < 3; ++r) plan.addWallY(xs[r], 3.0, 23.0);
   // Furniture so that rooms and corridor stretches differ.
-  plan.addBox(5.0, 9.0, 7.0, 11.0);
-  plan.addBox(18.0, 5.0, 21.0, 6.0);
-  plan.addBox(31.0, 8.0, 32.0, 12.0);
-  plan.addBox(6.0, 16.0, 8.0, 17.0);
-  plan.addBox(20.0, 19.0, 22.0, 21.5);
-  plan.addBox(28.0, 15.0, 30.0, 16.5);
+  // (in the rooms' corners, out of the route's way)
+  plan.addBox(3.4, 11.4, 5.0, 12.6);
+  plan.addBox(23.8, 3.3, 25.3, 4.3);
+  plan.addBox(35.5, 10.5, 36.6, 12.6);
+  plan.addBox(3.4, 13.4, 5.0, 14.4);
+  plan.addBox(22.5, 20.0, 24.5, 21.5);
+  plan.addBox(35.3, 13.4, 36.6, 15.0);
   plan.addBox(19.8, 0.2, 20.2, 0.6);
-  plan.addBox(38.8, 12.8, 39.8, 13.2);
+  plan.addBox(39.2, 12.8, 39.8, 13.2);
   plan.addBox(19.8, 25.4, 20.2, 25.8);
   for (int r = 0; r < 3; ++r) {
     plan.addRoom("south room " + std::to_string(r + 1), xs[r], 3.0, xs[r + 1], 13.0);
@@ -345,6 +367,146 @@ std::vector<Pose2D> loopBuildingRoute(int count) {
   waypoints.emplace_back(1.5, 24.5);
   waypoints.emplace_back(1.5, 1.5);  // back where it started: the loop closes
   waypoints.emplace_back(6.0, 1.5);
+  return evenlySpaced(waypoints, count);
+}
+
+namespace {
+
+/// One room of twentyRoomBuilding(): x0..x1 along the ring, its door wall
+/// on the ring at y = front, its back wall at y = back, the door centred at
+/// x = door.
+struct RingRoom {
+  double x0, x1, front, back, door;
+};
+
+/// The twenty rooms, row by row from west to east: south outer row, the
+/// block's south and north rows, north outer row. Widths and door places
+/// differ so that no two rooms look alike.
+std::vector<RingRoom> twentyRooms() {
+  std::vector<RingRoom> rooms;
+  const auto row = [&rooms](std::vector<double> walls, std::vector<double> doors, double front, double back) {
+    for (std::size_t r = 0; r + 1 < walls.size(); ++r) rooms.push_back({walls[r], walls[r + 1], front, back, doors[r]});
+  };
+  row({0, 10, 16, 25, 30, 38, 46}, {4.0, 13.0, 22.5, 27.5, 35.0, 41.5}, 8.0, 0.0);
+  row({3, 13, 21, 33, 43}, {7.0, 18.0, 26.0, 39.0}, 11.0, 20.0);
+  row({3, 10, 22, 33, 43}, {6.0, 15.0, 29.0, 37.5}, 29.0, 20.0);
+  row({0, 8, 18, 23, 32, 38, 46}, {3.5, 12.0, 20.5, 28.0, 34.0, 42.0}, 32.0, 40.0);
+  return rooms;
+}
+
+/// How far inside its walls the route goes round a room of twentyRooms();
+/// furniture stays at least 0.9 m clear of that loop.
+constexpr double kRoomLoopInset = 1.6;
+
+}  // namespace
+
+FloorPlan twentyRoomBuilding() {
+  FloorPlan plan;
+  // Outer walls, 46 x 40 m.
+  plan.addWallX(0.0, -0.1, 46.1);
+  plan.addWallX(40.0, -0.1, 46.1);
+  plan.addWallY(0.0, 0.0, 40.0);
+  plan.addWallY(46.0, 0.0, 40.0);
+  const std::vector<RingRoom> rooms = twentyRooms();
+  // Door walls: the outer rows face the ring at y = 8 and y = 32, the block
+  // at y = 11 and y = 29; the block's rows meet at y = 20.
+  for (double front : {8.0, 11.0, 29.0, 32.0}) {
+    std::vector<std::pair<double, double>> doors;
+    for (const RingRoom& r : rooms)
+      if (r.front == front) doors.emplace_back(r.door - 0.5, r.door + 0.5);
+    const bool block = front == 11.0 || front == 29.0;
+    plan.addWallX(front, block ? 2.9 : 0.0, block ? 43.1 : 46.0, doors);
+  }
+  plan.addWallX(20.0, 3.0, 43.0);
+  plan.addWallY(3.0, 11.0, 29.0);
+  plan.addWallY(43.0, 11.0, 29.0);
+  for (const RingRoom& r : rooms) {  // walls between neighbours
+    const bool west_end = r.x0 == 0.0 || r.x0 == 3.0;
+    if (!west_end) plan.addWallY(r.x0, std::min(r.front, r.back), std::max(r.front, r.back));
+  }
+
+  // Furniture, different in every room and at least 0.9 m clear of the
+  // route's loop (kRoomLoopInset): a cupboard against the back wall, a
+  // shelf against one side wall and, where the loop leaves room, a table in
+  // the middle.
+  for (std::size_t k = 0; k < rooms.size(); ++k) {
+    const RingRoom& r = rooms[k];
+    const double inward = r.back > r.front ? 1.0 : -1.0;  // from the door wall towards the back
+    const double width = r.x1 - r.x0, depth = std::abs(r.back - r.front);
+    const double cupboard = std::min(width - 1.0, 1.2 + double(k * 7 % 5) * 0.4);
+    const double cupboard_x = r.x0 + 0.3 + (width - 0.6 - cupboard) * double(k * 3 % 7) / 6.0;
+    const double back_face = r.back - inward * 0.15, back_depth = 0.45 + 0.05 * double(k % 3);
+    plan.addBox(cupboard_x, std::min(back_face, back_face - inward * back_depth), cupboard_x + cupboard,
+                std::max(back_face, back_face - inward * back_depth));
+    const double shelf = 1.0 + 0.5 * double(k % 3);
+    const double shelf_y = r.front + inward * (1.2 + (depth - 2.4 - shelf) * double(k * 5 % 4) / 3.0);
+    const double side_x = k % 2 ? r.x1 - 0.15 - 0.5 : r.x0 + 0.15;
+    const double shelf_end = shelf_y + inward * shelf;
+    plan.addBox(side_x, std::min(shelf_y, shelf_end), side_x + 0.5, std::max(shelf_y, shelf_end));
+    const double loop_width = width - 2 * kRoomLoopInset, loop_depth = depth - 2 * kRoomLoopInset;
+    if (loop_width >= 3.0 && loop_depth >= 3.0) {
+      const double half_x = std::min(loop_width / 2 - 0.9, 0.5 + 0.2 * double(k % 4));
+      const double half_y = std::min(loop_depth / 2 - 0.9, 0.4 + 0.15 * double(k % 3));
+      const double cx = (r.x0 + r.x1) / 2, cy = (r.front + r.back) / 2;
+      plan.addBox(cx - half_x, cy - half_y, cx + half_x, cy + half_y);
+    }
+  }
+  // Pillars and a bench along the ring, clear of the doors and the route.
+  plan.addBox(19.0, 8.3, 19.4, 8.7);
+  plan.addBox(45.3, 17.0, 45.8, 19.5);
+  plan.addBox(24.8, 31.3, 25.2, 31.7);
+  plan.addBox(0.2, 24.0, 0.6, 24.4);
+
+  for (std::size_t k = 0; k < rooms.size(); ++k) {
+    const RingRoom& r = rooms[k];
+    plan.addRoom("room " + std::to_string(k + 1), r.x0, std::min(r.front, r.back), r.x1, std::max(r.front, r.back));
+  }
+  plan.addRoom("south corridor", 0.0, 8.0, 46.0, 11.0);
+  plan.addRoom("north corridor", 0.0, 29.0, 46.0, 32.0);
+  plan.addRoom("west corridor", 0.0, 11.0, 3.0, 29.0);
+  plan.addRoom("east corridor", 43.0, 11.0, 46.0, 29.0);
+  return plan;
+}
+
+std::vector<Pose2D> twentyRoomBuildingRoute(int count) {
+  const std::vector<RingRoom> rooms = twentyRooms();
+  // Through the door, once round the room inside its walls (clockwise and
+  // counter-clockwise in turn), and back out to the corridor's middle.
+  std::vector<Eigen::Vector2d> waypoints;
+  const auto visit = [&waypoints](const RingRoom& r, double corridor_y, bool clockwise) {
+    const double inward = r.back > r.front ? 1.0 : -1.0;
+    const double x0 = r.x0 + kRoomLoopInset, x1 = r.x1 - kRoomLoopInset;
+    const double near_y = r.front + inward * kRoomLoopInset, far_y = r.back - inward * kRoomLoopInset;
+    const Eigen::Vector2d door(r.door, corridor_y), entry(r.door, near_y);
+    std::vector<Eigen::Vector2d> loop{{x1, near_y}, {x1, far_y}, {x0, far_y}, {x0, near_y}};
+    if (clockwise) std::reverse(loop.begin(), loop.end());
+    waypoints.push_back(door);
+    waypoints.push_back(entry);
+    waypoints.insert(waypoints.end(), loop.begin(), loop.end());
+    waypoints.push_back(entry);
+    waypoints.push_back(door);
+  };
+  // The rooms opening onto the south (north) corridor, in the order the
+  // route passes their doors.
+  const auto along = [&rooms](bool south, bool eastwards) {
+    std::vector<const RingRoom*> list;
+    for (const RingRoom& r : rooms)
+      if ((r.front < 20.0) == south) list.push_back(&r);
+    std::sort(list.begin(), list.end(), [eastwards](const RingRoom* a, const RingRoom* b) {
+      return eastwards ? a->door < b->door : a->door > b->door;
+    });
+    return list;
+  };
+  constexpr double south_y = 9.5, north_y = 30.5, west_x = 1.5, east_x = 44.5;
+  waypoints.emplace_back(west_x, south_y);
+  bool clockwise = false;
+  for (const RingRoom* r : along(true, true)) visit(*r, south_y, clockwise = !clockwise);
+  waypoints.emplace_back(east_x, south_y);
+  waypoints.emplace_back(east_x, north_y);
+  for (const RingRoom* r : along(false, false)) visit(*r, north_y, clockwise = !clockwise);
+  waypoints.emplace_back(west_x, north_y);
+  waypoints.emplace_back(west_x, south_y);  // back where it started: the loop closes
+  waypoints.emplace_back(8.0, south_y);
   return evenlySpaced(waypoints, count);
 }
 

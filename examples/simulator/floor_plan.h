@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
@@ -22,7 +23,20 @@ struct LaserModel {
   double field_of_view = 3.14159265358979323846;  ///< centred ahead, counter-clockwise
   double max_range = 30.0;                         ///< no return at or beyond
   double range_noise = 0.0;                        ///< Gaussian sigma, metres
+  /// The beams cover a full turn (field_of_view = 2 pi): they are spaced
+  /// field_of_view / beams apart, so that no direction is scanned twice (the
+  /// first beam points backwards, at -pi, and +pi is not repeated). Otherwise
+  /// the first and last beams lie on the edges of the field of view.
+  bool full_turn = false;
+
+  /// Direction of beam k, counter-clockwise, in a scan of `count` beams
+  /// (normally `beams`) taken facing `heading` (0: the angle in the sensor
+  /// frame).
+  double beamAngle(std::size_t k, std::size_t count, double heading = 0.0) const;
 };
+
+/// A laser scanning all around: 720 beams, one every half degree, 30 m.
+LaserModel fullTurnLaser(int beams = 720);
 
 /// A depth camera looking along the pose's heading, its optical axis level.
 /// Points come in the sensor frame: x ahead, y left, z up.
@@ -48,7 +62,8 @@ class FloorPlan {
   void addRoom(std::string name, double x0, double y0, double x1, double y1);
 
   /// Ranges of one scan (max_range where no wall is hit), beam k at angle
-  /// yaw - fov/2 + k * fov/(beams-1). Noise comes from `seed`.
+  /// laser.beamAngle(k, beams, yaw): yaw - fov/2 + k * fov/(beams-1), or
+  /// yaw - fov/2 + k * fov/beams for a full turn. Noise comes from `seed`.
   std::vector<double> scan(const Pose2D& pose, const LaserModel& laser, std::uint64_t seed = 0) const;
 
   /// Points of one depth image in the sensor frame, the camera standing at
@@ -58,16 +73,25 @@ class FloorPlan {
                                           std::uint64_t seed = 0) const;
   void setCeilingHeight(double height) { ceiling_ = height; }
 
-  /// Index of the room containing (x, y), or -1.
+  /// The box of a room given to addRoom.
+  struct Room {
+    double x0, y0, x1, y1;
+  };
+
+  /// Index of the room containing (x, y), or -1; where rooms overlap, the
+  /// one added first.
   int roomAt(double x, double y) const;
   const std::vector<std::string>& roomNames() const { return room_names_; }
+  const std::vector<Room>& rooms() const { return rooms_; }
+
+  /// Distance from (x, y) to the nearest wall in any horizontal direction
+  /// (sampled every degree), up to `max_distance`: a route's pose that is
+  /// closer to a wall than a robot's radius, or inside furniture, is a bug.
+  double clearanceAt(double x, double y, double max_distance = 5.0) const;
 
  private:
   struct Segment {
     Eigen::Vector2d a, b;
-  };
-  struct Room {
-    double x0, y0, x1, y1;
   };
   /// Distance along a horizontal ray to the first wall; infinity if none
   /// lies within `max_distance` (the search may stop there).
@@ -119,5 +143,17 @@ FloorPlan loopBuilding();
 /// A route around the whole ring that enters every room and closes the loop
 /// where it started, `count` poses.
 std::vector<Pose2D> loopBuildingRoute(int count = 260);
+
+/// A building of twenty rooms around a loop (46 x 40 m): a 3 m corridor
+/// ring around a block of eight rooms (four opening south, four north) and
+/// six rooms on each outer side of the ring, 5 to 12 m wide and 8 or 9 m
+/// deep, each with one 1 m door onto the ring and furniture of its own. The
+/// rooms are "room 1" to "room 20"; the ring is "south corridor", "east
+/// corridor", "north corridor" and "west corridor".
+FloorPlan twentyRoomBuilding();
+/// A route around the whole ring that enters every room of
+/// twentyRoomBuilding(), goes once round each room (facing all four ways)
+/// and closes the loop where it started, `count` poses.
+std::vector<Pose2D> twentyRoomBuildingRoute(int count = 600);
 
 }  // namespace obsgroup::sim

@@ -23,6 +23,14 @@ typename pcl::PointCloud<PointT>::Ptr toCloud(const std::vector<Eigen::Vector2d>
   return cloud;
 }
 
+/// One laser scan of `plan` taken at `pose` as a cloud in the sensor frame
+/// (z = 0); beams with no return give no point.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr scanCloud(const FloorPlan& plan, const Pose2D& pose, const LaserModel& laser,
+                                                std::uint64_t seed) {
+  return toCloud<PointT>(scanToPoints(plan.scan(pose, laser, seed), laser));
+}
+
 /// One depth image of `plan` as a cloud in the camera frame, its pose (the
 /// camera standing over `pose`) in the cloud's sensor origin and orientation,
 /// as a PCD file's VIEWPOINT stores it.

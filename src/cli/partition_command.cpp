@@ -143,12 +143,9 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
     world_frame.setRegionParameters(args.region);
     const WorldPoints world = world_frame.toWorld(observations);
     ObservationRegions regions;
-    io::RegionTint tint;
-    if (args.sso != SensedSpaceModel::Points) {
-      regions = world_frame.computeRegions(observations, world);
-      tint = {&regions, args.region.cell_size};
-    }
-    io::writeMapPictures(out, world, poses, partition, topology, tint);
+    const bool tinted = args.sso != SensedSpaceModel::Points;
+    if (tinted) regions = world_frame.computeRegions(observations, world);
+    io::writeMapPictures(out, world, poses, partition, topology, tinted ? &regions : nullptr);
     io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
     io::writeFiedlerPicture(out, partition);
   }

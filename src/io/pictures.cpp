@@ -83,19 +83,19 @@ std::uint32_t argbOf(const Rgb& c) {
 
 /// Each region cell in a pale shade of the group most of whose observations
 /// hold it (ties: the lower group). Cells of 3D regions are seen from above.
-void tintRegions(const RegionTint& tint, const Partition& partition, const View& v, unsigned char* data, int stride) {
-  const ObservationRegions& regions = *tint.regions;
+void tintRegions(const ObservationRegions& regions, const Partition& partition, const View& v, unsigned char* data,
+                 int stride) {
   std::vector<std::pair<std::uint64_t, int>> cells;  // (plane cell, group)
   cells.reserve(regions.cells.size());
   for (int i = 0; i < regions.size(); ++i)
     for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
-      const Eigen::Vector3d c = regionCellCentre(regions.cells[k], regions.planar, tint.cell_size);
+      const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
       const std::uint64_t px = std::uint64_t(std::uint32_t(std::lround(v.px(c.x()))));
       const std::uint64_t py = std::uint64_t(std::uint32_t(std::lround(v.py(c.y()))));
       cells.emplace_back((px << 32) | py, partition.group_of[i]);
     }
   std::sort(cells.begin(), cells.end());
-  const int half = std::max(1, int(std::ceil(tint.cell_size * v.scale / 2)));
+  const int half = std::max(1, int(std::ceil(regions.cell_size * v.scale / 2)));
   for (std::size_t a = 0; a < cells.size();) {
     int best = -1, best_count = 0;
     std::size_t b = a;
@@ -117,12 +117,13 @@ void tintRegions(const RegionTint& tint, const Partition& partition, const View&
 
 /// The points, one pixel (or a 2x2 block when they are few) each, over the
 /// tinted regions when there are some.
-Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v, const RegionTint& tint) {
+Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v,
+                     const ObservationRegions* regions) {
   Surface surface = imageSurface(v.width, v.height);
   cairo_surface_flush(surface.get());
   unsigned char* data = cairo_image_surface_get_data(surface.get());
   const int stride = cairo_image_surface_get_stride(surface.get());
-  if (tint.regions) tintRegions(tint, partition, v, data, stride);
+  if (regions) tintRegions(*regions, partition, v, data, stride);
   const int dot = world.points.size() < 300000 ? 2 : 1;
   for (int i = 0; i < world.size(); ++i) {
     const Rgb c = groupColour(partition.group_of[i]);
@@ -204,7 +205,7 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
 }  // namespace
 
 void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
-                      const Partition& partition, const TopologicalMap& topology, const RegionTint& tint) {
+                      const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
   std::vector<Eigen::Vector2d> positions;
   std::vector<double> headings;
   for (const auto& pose : poses) {
@@ -213,7 +214,7 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const s
     headings.push_back(std::atan2(ahead.y(), ahead.x()));
   }
   const View v = fitView(world, positions);
-  const Surface points = rasterPoints(world, partition, v, tint);
+  const Surface points = rasterPoints(world, partition, v, regions);
 
   Surface png = imageSurface(v.width, v.height);
   {

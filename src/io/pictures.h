@@ -14,19 +14,14 @@
 
 namespace obsgroup::io {
 
-/// The regions of the free-space and visibility models, to tint the map with.
-struct RegionTint {
-  const ObservationRegions* regions = nullptr;
-  double cell_size = 0.0;
-};
-
 /// map.png and map.svg: every point from above coloured by its group, each
 /// pose as an arrow, and the topological arcs between group centres. With
 /// regions, each cell is first tinted with the colour of the group most of
 /// whose observations hold it: the place each group stands for.
 /// `poses` are in the same frame as `world` before re-centring.
 void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
-                      const Partition& partition, const TopologicalMap& topology, const RegionTint& tint = {});
+                      const Partition& partition, const TopologicalMap& topology,
+                      const ObservationRegions* regions = nullptr);
 
 /// weights.png: W as an image, rows and columns ordered by group, darker for
 /// a larger overlap, each group boxed.

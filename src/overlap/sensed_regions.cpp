@@ -172,12 +172,23 @@ void traverse(const std::array<double, D>& from, const std::array<double, D>& to
   }
 }
 
-template <int D>
-std::array<double, D> inCells(const Eigen::Vector3d& p, double cell) {
-  std::array<double, D> out;
-  for (int a = 0; a < D; ++a) out[a] = p[a] / cell;
-  return out;
-}
+/// The cell grid, anchored on the first observation (the origin of the
+/// re-centred frame) so that a map at UTM coordinates has the same cells as
+/// the same map near 0. The first sensor sits at a cell's centre, not on its
+/// corner: routes that keep one coordinate (a corridor's axis) then do not
+/// run along cell edges, where rounding would pick the side.
+struct CellGrid {
+  explicit CellGrid(double cell_size) : size(cell_size) {}
+  /// Re-centred coordinates in cells.
+  template <int D>
+  std::array<double, D> inCells(const Eigen::Vector3d& p) const {
+    std::array<double, D> out;
+    for (int a = 0; a < D; ++a) out[a] = p[a] / size + phase[a];
+    return out;
+  }
+  double size;
+  std::array<double, 3> phase{0.5, 0.5, 0.5};
+};
 
 template <int D>
 Cell<D> cellOf(const std::array<double, D>& p) {
@@ -205,16 +216,16 @@ std::pair<Cell<D>, Cell<D>> boxAround(const std::array<double, D>& origin, doubl
 /// (or to max_range along it).
 template <int D>
 void freeSpaceOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin, const RegionParameters& params,
-                 RegionMarker<D>& marker, std::vector<std::uint64_t>& out) {
+                 const CellGrid& grid, RegionMarker<D>& marker, std::vector<std::uint64_t>& out) {
   if (world.count(i) == 0) return;
-  const double s = params.cell_size, range = params.max_range / s;
-  const auto o = inCells<D>(origin, s);
+  const double range = params.max_range / grid.size;
+  const auto o = grid.inCells<D>(origin);
   // The box of the beams: the origin and every (clipped) end point.
   std::vector<std::array<double, D>> ends;
   ends.reserve(world.count(i));
   Cell<D> lo = cellOf<D>(o), hi = lo;
   for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
-    std::array<double, D> e = inCells<D>(p->cast<double>(), s);
+    std::array<double, D> e = grid.inCells<D>(p->cast<double>());
     double length = 0;
     for (int a = 0; a < D; ++a) length += (e[a] - o[a]) * (e[a] - o[a]);
     length = std::sqrt(length);
@@ -287,7 +298,8 @@ bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, const Regio
 
 /// The plane cells occupied by at least params.min_observations observations.
 std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins,
-                                         const RegionParameters& params, bool planar, int threads) {
+                                         const RegionParameters& params, const CellGrid& grid, bool planar,
+                                         int threads) {
   const int n = world.size();
   std::vector<std::vector<std::uint64_t>> per_observation(n);
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
@@ -295,7 +307,7 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
     auto& keys = per_observation[i];
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
       if (inBand(*p, origins[i], params, planar))
-        keys.push_back(keyOf<2>(cellOf<2>(inCells<2>(p->cast<double>(), params.cell_size))));
+        keys.push_back(keyOf<2>(cellOf<2>(grid.inCells<2>(p->cast<double>()))));
     std::sort(keys.begin(), keys.end());
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   }
@@ -323,10 +335,11 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
 /// fixed set of world angles (so the heading plays no part), each stopped by
 /// the first occupied cell it enters beyond the clearance, that cell included.
 void visibilityOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin, const RegionParameters& params,
-                  OccupancyGrid::Reader& occupancy, RegionMarker<2>& marker, std::vector<std::uint64_t>& out) {
+                  const CellGrid& grid, OccupancyGrid::Reader& occupancy, RegionMarker<2>& marker,
+                  std::vector<std::uint64_t>& out) {
   if (world.count(i) == 0) return;  // an observation with no point sensed nothing
-  const double s = params.cell_size, range = params.max_range / s, clear = params.clearance / params.max_range;
-  const auto o = inCells<2>(origin, s);
+  const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
+  const auto o = grid.inCells<2>(origin);
   const auto [lo, hi] = boxAround<2>(o, range);
   marker.reset(lo, hi);
   // Adjacent rays at most one cell apart at full range.
@@ -334,9 +347,14 @@ void visibilityOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin
   for (int r = 0; r < rays; ++r) {
     const double angle = 2.0 * 3.14159265358979323846 * r / rays;
     const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
+    // Only the occupied cells a ray starts among are passed, and only
+    // within the clearance: once it has crossed a free cell, the next
+    // occupied cell is a wall seen from inside and stops it.
+    bool crossed_free = false;
     traverse<2>(o, end, [&](const Cell<2>& c, double t) {
       marker.mark(c);
-      return t < clear || !occupancy.occupied(c);
+      if (!occupancy.occupied(c)) return crossed_free = true;
+      return !crossed_free && t < clear;
     });
   }
   marker.emit(out);
@@ -346,22 +364,24 @@ void checkParameters(const RegionParameters& p) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!positive(p.cell_size)) throw std::invalid_argument("region cell size must be finite and > 0");
   if (!positive(p.max_range)) throw std::invalid_argument("region range must be finite and > 0");
-  if (p.max_range / p.cell_size > 4096)
-    throw std::invalid_argument("region range is more than 4096 cells: raise the cell size or lower the range");
+  // 2000 cells keeps a region's bitmap (4000^2 cells in 2D) within the dense marker.
+  if (p.max_range / p.cell_size > 2000)
+    throw std::invalid_argument("region range is more than 2000 cells: raise the cell size or lower the range");
   if (!(std::isfinite(p.clearance) && p.clearance >= 0)) throw std::invalid_argument("clearance must be finite and >= 0");
   if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
   if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
     throw std::invalid_argument("height band must be finite with low < high");
 }
 
-/// True when every point and every sensor lies at one height: 2D data.
-bool isPlanar(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins) {
+/// True when every point and every sensor lies within a quarter cell of one
+/// height: 2D data (scans whose poses carry a few mm of z included).
+bool isPlanar(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins, double cell_size) {
   if (origins.empty()) return true;
-  const double z0 = origins[0].z();
+  const double z0 = origins[0].z(), tolerance = 0.25 * cell_size;
   for (const auto& o : origins)
-    if (std::abs(o.z() - z0) > 1e-3) return false;
+    if (std::abs(o.z() - z0) > tolerance) return false;
   for (const auto& p : world.points)
-    if (std::abs(double(p.z()) - z0) > 1e-3) return false;
+    if (std::abs(double(p.z()) - z0) > tolerance) return false;
   return true;
 }
 
@@ -388,14 +408,16 @@ void checkReach(const WorldPoints& world, const std::vector<Eigen::Vector3d>& or
 
 }  // namespace
 
-Eigen::Vector3d regionCellCentre(std::uint64_t key, bool planar, double cell_size) {
-  if (planar)
-    return {(double(std::int64_t(key >> 32) - kBias2) + 0.5) * cell_size,
-            (double(std::int64_t(key & 0xffffffffu) - kBias2) + 0.5) * cell_size, 0.0};
-  const std::uint64_t mask = (std::uint64_t(1) << 21) - 1;
-  return {(double(std::int64_t(key >> 42) - kBias3) + 0.5) * cell_size,
-          (double(std::int64_t((key >> 21) & mask) - kBias3) + 0.5) * cell_size,
-          (double(std::int64_t(key & mask) - kBias3) + 0.5) * cell_size};
+Eigen::Vector3d ObservationRegions::cellCentre(std::uint64_t key) const {
+  Eigen::Vector3d cell;
+  if (planar) {
+    cell << double(std::int64_t(key >> 32) - kBias2), double(std::int64_t(key & 0xffffffffu) - kBias2), phase[2] - 0.5;
+  } else {
+    const std::uint64_t mask = (std::uint64_t(1) << 21) - 1;
+    cell << double(std::int64_t(key >> 42) - kBias3), double(std::int64_t((key >> 21) & mask) - kBias3),
+        double(std::int64_t(key & mask) - kBias3);
+  }
+  return (cell + Eigen::Vector3d::Constant(0.5) - phase) * cell_size;
 }
 
 ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& world,
@@ -412,11 +434,14 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   threads = threadCount(threads);
 
   ObservationRegions regions;
-  regions.planar = isPlanar(world, sensor_origins);
+  regions.planar = isPlanar(world, sensor_origins, params.cell_size);
+  const CellGrid cells(params.cell_size);
+  regions.cell_size = params.cell_size;
+  for (int a = 0; a < 3; ++a) regions.phase[a] = cells.phase[a];
   const bool volumetric = model == SensedSpaceModel::FreeSpace && !regions.planar;
   checkReach(world, sensor_origins, params, volumetric);
   std::vector<std::uint64_t> occupied;
-  if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, regions.planar, threads);
+  if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, cells, regions.planar, threads);
   const OccupancyGrid grid(occupied);
   std::vector<std::vector<std::uint64_t>> per_observation(n);
   FirstError error;
@@ -430,11 +455,11 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
       if (interruptRequested(interrupt)) continue;
       try {
         if (model == SensedSpaceModel::Visibility)
-          visibilityOf(world, i, sensor_origins[i], params, reader, marker2, per_observation[i]);
+          visibilityOf(world, i, sensor_origins[i], params, cells, reader, marker2, per_observation[i]);
         else if (volumetric)
-          freeSpaceOf<3>(world, i, sensor_origins[i], params, marker3, per_observation[i]);
+          freeSpaceOf<3>(world, i, sensor_origins[i], params, cells, marker3, per_observation[i]);
         else
-          freeSpaceOf<2>(world, i, sensor_origins[i], params, marker2, per_observation[i]);
+          freeSpaceOf<2>(world, i, sensor_origins[i], params, cells, marker2, per_observation[i]);
       } catch (...) {
         error.keep(i, std::current_exception());
       }
@@ -456,6 +481,14 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
 MatchCounts countSharedCells(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
   const int n = regions.size();
   threads = threadCount(threads);
+  if (regions.offsets.empty() || regions.offsets.front() != 0 || regions.offsets.back() != regions.cells.size() ||
+      !std::is_sorted(regions.offsets.begin(), regions.offsets.end()))
+    throw std::invalid_argument("countSharedCells: offsets must run from 0 to the number of cells, ascending");
+  for (int i = 0; i < n; ++i)
+    for (std::size_t k = regions.offsets[i] + 1; k < regions.offsets[i + 1]; ++k)
+      if (regions.cells[k] <= regions.cells[k - 1])
+        throw std::invalid_argument("countSharedCells: the cells of observation " + std::to_string(i) +
+                                    " must be ascending and distinct");
   // Group the (cell, observation) entries by cell: one sort of all of them.
   struct Entry {
     std::uint64_t key;

@@ -63,14 +63,17 @@ struct ObservationRegions {
   std::vector<std::uint64_t> cells;
   std::vector<std::size_t> offsets{0};
   bool planar = true;  ///< 2D cells (x, y) or 3D voxels
+  double cell_size = 1.0;
+  /// Where the cells lie: a cell's corner is at (k - phase) * cell_size in
+  /// the re-centred frame of the WorldPoints (the first sensor at a centre).
+  Eigen::Vector3d phase = Eigen::Vector3d::Constant(0.5);
 
   int size() const { return static_cast<int>(offsets.size()) - 1; }
   std::size_t count(int i) const { return offsets[i + 1] - offsets[i]; }
+  /// The centre of a cell in the re-centred frame of the WorldPoints the
+  /// regions were computed from (for plane cells, z is the grid's 0).
+  Eigen::Vector3d cellCentre(std::uint64_t key) const;
 };
-
-/// The centre of a region cell, in the re-centred frame of its WorldPoints
-/// (z is 0 for plane cells).
-Eigen::Vector3d regionCellCentre(std::uint64_t key, bool planar, double cell_size);
 
 /// The regions of `world`'s observations under `model` (FreeSpace or
 /// Visibility), the sensor of observation i at sensor_origins[i] (re-centred

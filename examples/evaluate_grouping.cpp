@@ -1,0 +1,544 @@
+// The evidence behind docs/grouping.md: which sensed-space model groups the
+// observations of a building into its rooms? Simulated buildings give the
+// true place of every pose; each dataset is a building scanned along its
+// route by one sensor, the grouping seeing either the true poses or a
+// drifted copy of them (the scans are always taken at the true poses).
+// Measured per dataset and configuration: the number of groups, their mean
+// size, the adjusted Rand index against the true places (rooms and corridor
+// stretches) and how many rooms land whole in one group.
+//
+//   evaluate_grouping [--output FILE] [parameters]
+//       the six configurations of the page (models points, free-space and
+//       visibility, each split by mean and by best Ncut) on every dataset;
+//       prints the tables, or writes them into FILE between the lines
+//       "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
+//   evaluate_grouping --model M [--split S] [parameters] [selection]
+//       one configuration: a line per dataset and a summary line, for sweeps.
+//
+// Run with --help for the parameters and the selection of datasets.
+
+#include "floor_plan.h"
+#include "scenarios.h"
+#include "to_cloud.h"
+
+#include <obsgroup/observation_grouping.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace obsgroup;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+namespace {
+
+/// The drift of the "drift" datasets; one seed for every building and sensor,
+/// so that a building's drifted route is the same whatever scans it.
+constexpr std::uint64_t kDriftSeed = 7;
+/// Corridors are cut into places of about this length (see sim::placesAlong).
+constexpr double kStretchLength = 8.0;
+/// A pose nearer a wall than this is reported (a robot is wider).
+constexpr double kCrampedClearance = 0.25;
+
+/// printf into a std::string (the tables' numbers).
+std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* pattern, ...) {
+  char buffer[1024];
+  va_list args;
+  va_start(args, pattern);
+  std::vsnprintf(buffer, sizeof buffer, pattern, args);
+  va_end(args);
+  return buffer;
+}
+
+enum class PoseSource { Exact, Drift };
+
+std::string toString(PoseSource poses) { return poses == PoseSource::Exact ? "exact" : "drift"; }
+
+PoseSource poseSourceFromString(const std::string& name) {
+  if (name == "exact") return PoseSource::Exact;
+  if (name == "drift") return PoseSource::Drift;
+  throw std::invalid_argument("unknown poses '" + name + "' (exact or drift)");
+}
+
+/// One building scanned by one sensor, seen through exact or drifted poses.
+struct Dataset {
+  std::string building, title;
+  sim::Sensor sensor = sim::Sensor::Laser360;
+  PoseSource poses = PoseSource::Exact;
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  sim::Places places;
+  int rooms = 0;            ///< true rooms (not corridor stretches) with at least one pose
+  double drift_rms = 0.0;   ///< of the poses the grouping sees, from the true poses, metres
+  double mean_points = 0.0;
+  /// Poses of the route closer than kCrampedClearance to a wall, or inside
+  /// furniture: their scans see little but that wall or box.
+  int cramped_poses = 0;
+
+  std::string name() const { return building + " " + sim::toString(sensor) + " " + toString(poses); }
+  std::string heading() const {
+    return title + "; " + sim::describe(sensor) + ", " + (poses == PoseSource::Exact ? "exact" : "drifted") + " poses";
+  }
+};
+
+/// Generates the selected datasets. A building's scans are made once per
+/// sensor and shared (the clouds are reference counted) by its exact and
+/// drifted datasets, which differ only in the poses.
+std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, const std::vector<sim::Sensor>& sensors,
+                                  const std::vector<PoseSource>& pose_sources) {
+  std::vector<Dataset> datasets;
+  for (const std::string& key : buildings) {
+    const sim::Building building = sim::makeBuilding(key);
+    const sim::Places places = sim::placesAlong(building.plan, building.route, kStretchLength);
+    std::set<int> rooms_visited;
+    for (int place : places.of_pose)
+      if (places.is_room[place]) rooms_visited.insert(place);
+    int cramped = 0;
+    for (const sim::Pose2D& pose : building.route)
+      cramped += building.plan.clearanceAt(pose.x, pose.y, kCrampedClearance) < kCrampedClearance;
+    for (sim::Sensor sensor : sensors) {
+      // The sensor frame's height: a depth camera stands over the floor, a
+      // laser scans in the plane z = 0.
+      const double height = sensor == sim::Sensor::Depth ? sim::depthCamera().height_above_floor : 0.0;
+      std::vector<Cloud::ConstPtr> clouds;
+      std::vector<Eigen::Isometry3d> truth;
+      std::size_t points = 0;
+      for (std::size_t k = 0; k < building.route.size(); ++k) {
+        const sim::Pose2D& pose = building.route[k];
+        Cloud::ConstPtr cloud;
+        switch (sensor) {
+          case sim::Sensor::Laser360:
+            cloud = sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser360(), k);
+            break;
+          case sim::Sensor::Laser180:
+            cloud = sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser180(), k);
+            break;
+          case sim::Sensor::Depth:
+            cloud = sim::depthCloud<pcl::PointXYZ>(building.plan, pose, sim::depthCamera(), k);
+            break;
+        }
+        points += cloud->size();
+        clouds.push_back(cloud);
+        truth.push_back(sim::toIsometry(pose, height));
+      }
+      const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
+      for (PoseSource source : pose_sources) {
+        Dataset d;
+        d.building = key;
+        d.title = building.title;
+        d.sensor = sensor;
+        d.poses = source;
+        d.places = places;
+        d.rooms = static_cast<int>(rooms_visited.size());
+        d.cramped_poses = cramped;
+        d.mean_points = clouds.empty() ? 0.0 : double(points) / double(clouds.size());
+        const std::vector<Eigen::Isometry3d>& seen = source == PoseSource::Exact ? truth : drifted;
+        d.drift_rms = sim::rmsPositionError(seen, truth);
+        for (std::size_t k = 0; k < clouds.size(); ++k) d.observations.push_back({clouds[k], seen[k]});
+        datasets.push_back(std::move(d));
+      }
+    }
+  }
+  return datasets;
+}
+
+/// Everything ObservationGrouping is given besides the observations.
+struct Configuration {
+  SensedSpaceModel model = SensedSpaceModel::Points;
+  SplitCriterion split = SplitCriterion::Mean;
+  double match_distance = 0.1;  ///< delta of the points model: the paper's
+  RegionParameters region;      ///< of the free-space and visibility models
+  int min_group_size = 1;
+  double ncut_threshold = 1.0;  ///< the paper's
+  int threads = 0;  ///< 0: all cores
+
+  /// The page's row label: the model (with δ for points) and the split; the
+  /// region parameters are common to all rows and stated once.
+  std::string label() const {
+    const std::string delta = model == SensedSpaceModel::Points ? format(" δ %g m", match_distance) : std::string();
+    return toString(model) + delta + ", split " + toString(split);
+  }
+
+  /// Every parameter, for the summary line of a sweep.
+  std::string parameters() const {
+    return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
+                  "min-group-size=%d ncut-threshold=%g",
+                  toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
+                  region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
+                  min_group_size, ncut_threshold);
+  }
+};
+
+struct Result {
+  int groups = 0;
+  double mean_group_size = 0.0;
+  double ari = 0.0;
+  int rooms_whole = 0, rooms = 0;
+  double seconds = 0.0;  ///< ObservationGrouping::compute() alone, wall time
+  std::size_t warnings = 0;
+  std::string error;  ///< what compute() threw; the numbers are then meaningless
+};
+
+/// Adjusted Rand index of two labellings (Hubert and Arabie): 1 when they
+/// are the same partition, about 0 for a chance agreement.
+double adjustedRandIndex(const std::vector<int>& a, const std::vector<int>& b) {
+  std::map<std::pair<int, int>, double> table;
+  std::map<int, double> rows, cols;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    table[{a[i], b[i]}] += 1;
+    rows[a[i]] += 1;
+    cols[b[i]] += 1;
+  }
+  const auto pairs = [](double n) { return n * (n - 1) / 2; };
+  double index = 0, sum_rows = 0, sum_cols = 0;
+  for (const auto& [key, n] : table) index += pairs(n);
+  for (const auto& [key, n] : rows) sum_rows += pairs(n);
+  for (const auto& [key, n] : cols) sum_cols += pairs(n);
+  const double expected = sum_rows * sum_cols / pairs(double(a.size()));
+  const double maximum = (sum_rows + sum_cols) / 2;
+  return maximum == expected ? 0.0 : (index - expected) / (maximum - expected);
+}
+
+Result evaluate(const Dataset& d, const Configuration& c) {
+  Result r;
+  r.rooms = d.rooms;
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  for (const auto& o : d.observations) grouping.addObservation(o.cloud, o.pose);
+  grouping.setSensedSpaceModel(c.model);
+  grouping.setRegionParameters(c.region);
+  grouping.setMatchDistance(c.match_distance);
+  PartitionOptions options = grouping.getPartitionOptions();
+  options.split = c.split;
+  options.min_group_size = c.min_group_size;
+  options.ncut_threshold = c.ncut_threshold;
+  options.keep_eigenvectors = false;  // only the groups are measured
+  grouping.setPartitionOptions(options);
+  grouping.setNumberOfThreads(c.threads);
+  Partition p;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    p = grouping.compute();
+  } catch (const std::exception& e) {
+    r.error = e.what();
+    return r;
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.warnings = grouping.getWarnings().size();
+  r.groups = static_cast<int>(p.groups.size());
+  r.mean_group_size = r.groups ? double(d.observations.size()) / r.groups : 0.0;
+  r.ari = adjustedRandIndex(d.places.of_pose, p.group_of);
+  std::map<int, std::set<int>> groups_of_room;
+  for (std::size_t i = 0; i < d.places.of_pose.size(); ++i)
+    if (d.places.is_room[d.places.of_pose[i]]) groups_of_room[d.places.of_pose[i]].insert(p.group_of[i]);
+  for (const auto& [room, groups] : groups_of_room) r.rooms_whole += groups.size() == 1;
+  return r;
+}
+
+/// Results of one configuration over the datasets.
+struct Summary {
+  double mean_ari = 0.0;
+  int rooms_whole = 0, rooms = 0;
+  double worst_ari = 1.0;
+  std::string worst;  ///< the dataset of the worst ARI
+  double seconds = 0.0;
+  int datasets = 0;  ///< evaluated without error
+  int errors = 0;
+};
+
+Summary summarize(const std::vector<Dataset>& datasets, const std::vector<Result>& results,
+                  const std::function<bool(const Dataset&)>& include = nullptr) {
+  Summary s;
+  for (std::size_t k = 0; k < datasets.size(); ++k) {
+    if (include && !include(datasets[k])) continue;
+    const Result& r = results[k];
+    s.seconds += r.seconds;
+    if (!r.error.empty()) {
+      ++s.errors;
+      continue;
+    }
+    ++s.datasets;
+    s.mean_ari += r.ari;
+    s.rooms_whole += r.rooms_whole;
+    s.rooms += r.rooms;
+    if (r.ari < s.worst_ari || s.worst.empty()) s.worst_ari = r.ari, s.worst = datasets[k].name();
+  }
+  if (s.datasets) s.mean_ari /= s.datasets;
+  return s;
+}
+
+/// An exception's text fit for one table cell or one line.
+std::string errorText(const std::string& error) {
+  std::string text = error.substr(0, 120);
+  std::replace(text.begin(), text.end(), '|', '/');
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return text;
+}
+
+/// The single-configuration mode: one line per dataset, then the summary.
+int evaluateOneConfiguration(const std::vector<Dataset>& datasets, const Configuration& c) {
+  std::vector<Result> results;
+  for (const Dataset& d : datasets) {
+    const Result r = evaluate(d, c);
+    if (!r.error.empty())
+      std::cout << format("%-24s error: %s\n", d.name().c_str(), errorText(r.error).c_str());
+    else
+      std::cout << format("%-24s %4zu scans  drift %4.2f m  groups %4d (size %5.1f)  ARI %6.3f  rooms whole %2d/%-2d"
+                          "  %6.2f s%s\n",
+                          d.name().c_str(), d.observations.size(), d.drift_rms, r.groups, r.mean_group_size, r.ari,
+                          r.rooms_whole, r.rooms, r.seconds,
+                          r.warnings ? format("  (%zu warnings)", r.warnings).c_str() : "");
+    std::cout.flush();
+    results.push_back(r);
+  }
+  const Summary s = summarize(datasets, results);
+  const std::string worst = s.datasets ? format("%.3f (%s)", s.worst_ari, s.worst.c_str()) : std::string("–");
+  std::cout << format("summary %s: mean ARI %.3f  rooms whole %d/%d  worst ARI %s  %.1f s%s\n", c.parameters().c_str(),
+                      s.mean_ari, s.rooms_whole, s.rooms, worst.c_str(), s.seconds,
+                      s.errors ? format("  %d ERRORS", s.errors).c_str() : "");
+  return s.errors ? 1 : 0;
+}
+
+/// The page's generated section: the datasets, a summary per configuration
+/// and a table per dataset.
+std::string page(const std::vector<Dataset>& datasets, const std::vector<Configuration>& configurations,
+                 double generation_seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::vector<Result>> results(configurations.size());
+  for (std::size_t k = 0; k < datasets.size(); ++k) {
+    std::cerr << datasets[k].name() << ":";
+    for (std::size_t c = 0; c < configurations.size(); ++c) {
+      results[c].push_back(evaluate(datasets[k], configurations[c]));
+      std::cerr << format(" %.3f", results[c].back().ari);
+    }
+    std::cerr << "\n";
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::ostringstream out;
+  const Configuration& common = configurations.front();
+  out << "Parameters of every row: δ " << common.match_distance << " m (points); cell " << common.region.cell_size
+      << " m, range " << common.region.max_range << " m, clearance " << common.region.clearance
+      << " m, min observations " << common.region.min_observations << ", band " << common.region.band_low << " to "
+      << common.region.band_high << " m (free space, visibility); minimum group size " << common.min_group_size
+      << "; everything else the library's default.\n\n";
+
+  out << "### Summary over the " << datasets.size() << " datasets\n\n"
+      << "| configuration | mean ARI | exact / drifted poses | 360° laser / 180° laser / depth camera "
+         "| rooms whole | worst ARI (dataset) | time (s) |\n"
+      << "|---|---|---|---|---|---|---|\n";
+  for (std::size_t c = 0; c < configurations.size(); ++c) {
+    const Summary all = summarize(datasets, results[c]);
+    const auto ari_where = [&](const std::function<bool(const Dataset&)>& include) {
+      const Summary s = summarize(datasets, results[c], include);
+      return s.datasets ? format("%.2f", s.mean_ari) : std::string("–");
+    };
+    const auto of_poses = [](PoseSource p) { return [p](const Dataset& d) { return d.poses == p; }; };
+    const auto of_sensor = [](sim::Sensor s) { return [s](const Dataset& d) { return d.sensor == s; }; };
+    out << "| " << configurations[c].label() << " | " << format("%.3f", all.mean_ari) << " | "
+        << ari_where(of_poses(PoseSource::Exact)) << " / " << ari_where(of_poses(PoseSource::Drift)) << " | "
+        << ari_where(of_sensor(sim::Sensor::Laser360)) << " / " << ari_where(of_sensor(sim::Sensor::Laser180))
+        << " / " << ari_where(of_sensor(sim::Sensor::Depth)) << " | " << all.rooms_whole << " of " << all.rooms
+        << " | " << format("%.2f", all.worst_ari) << " (" << all.worst << ") | " << format("%.1f", all.seconds)
+        << (all.errors ? format(" (%d failed)", all.errors) : std::string()) << " |\n";
+  }
+
+  // One row per building and sensor: its exact and drifted datasets share the scans.
+  out << "\n### Datasets\n\n"
+      << "| building, sensor | scans | points per scan | places (rooms + corridor stretches) "
+      << "| drift RMS of the drifted poses (m) | poses < " << kCrampedClearance << " m from a wall or in furniture |\n"
+      << "|---|---|---|---|---|---|\n";
+  std::set<std::pair<std::string, sim::Sensor>> listed;
+  for (const Dataset& d : datasets) {
+    if (!listed.insert({d.building, d.sensor}).second) continue;
+    std::string drift = "–";
+    for (const Dataset& other : datasets)
+      if (other.building == d.building && other.sensor == d.sensor && other.poses == PoseSource::Drift)
+        drift = format("%.2f", other.drift_rms);
+    const int places = static_cast<int>(d.places.names.size());
+    out << "| " << d.building << ", " << sim::describe(d.sensor) << " | " << d.observations.size() << " | "
+        << format("%.0f", d.mean_points) << " | " << places << " (" << d.rooms << " + " << places - d.rooms << ") | "
+        << drift << " | " << d.cramped_poses << " |\n";
+  }
+
+  for (std::size_t k = 0; k < datasets.size(); ++k) {
+    const Dataset& d = datasets[k];
+    out << "\n#### " << d.heading() << "\n\n"
+        << "| configuration | groups | mean group size | ARI vs places | rooms whole | time (s) |\n"
+        << "|---|---|---|---|---|---|\n";
+    for (std::size_t c = 0; c < configurations.size(); ++c) {
+      const Result& r = results[c][k];
+      if (!r.error.empty())
+        out << "| " << configurations[c].label() << " | failed: " << errorText(r.error) << " | | | | |\n";
+      else
+        out << "| " << configurations[c].label() << " | " << r.groups << " | " << format("%.1f", r.mean_group_size)
+            << " | " << format("%.3f", r.ari) << " | " << r.rooms_whole << " of " << r.rooms << " | "
+            << format("%.2f", r.seconds) << " |\n";
+    }
+  }
+  out << format("\n(datasets generated in %.1f s, evaluated in %.1f s", generation_seconds, seconds)
+      << (common.threads ? format(", %d threads", common.threads) : std::string(", all cores")) << ")\n";
+  return out.str();
+}
+
+int writeGeneratedSection(const std::string& file, const std::string& report) {
+  std::ifstream in(file);
+  std::stringstream existing;
+  existing << in.rdbuf();
+  const std::string text = existing.str();
+  const std::string begin = "<!-- generated:begin -->\n", end = "<!-- generated:end -->";
+  const std::size_t b = text.find(begin), e = text.find(end);
+  if (b == std::string::npos || e == std::string::npos || e < b) {
+    std::cerr << "error: " << file << ": no '<!-- generated:begin -->' ... '<!-- generated:end -->' section\n";
+    return 3;
+  }
+  std::ofstream(file) << text.substr(0, b + begin.size()) << report << text.substr(e);
+  std::cout << "updated " << file << "\n";
+  return 0;
+}
+
+/// The whole of `text` as a number; a trailing "abc" is an error, not ignored.
+double parseNumber(const std::string& flag, const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::logic_error&) {  // std::invalid_argument, std::out_of_range
+    used = 0;
+  }
+  if (used == 0 || used != text.size()) throw std::invalid_argument("bad number for " + flag + ": '" + text + "'");
+  return value;
+}
+
+int parseInteger(const std::string& flag, const std::string& text) {
+  const double value = parseNumber(flag, text);
+  if (!(std::abs(value) < 1e9) || value != static_cast<int>(value))
+    throw std::invalid_argument("bad integer for " + flag + ": '" + text + "'");
+  return static_cast<int>(value);
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+const char* kUsage =
+    "usage: evaluate_grouping [--output FILE] [parameters] [selection]\n"
+    "       evaluate_grouping --model M [--split S] [parameters] [selection]\n"
+    "Without --model: the page's six configurations (points, free-space, visibility; split mean and best).\n"
+    "With --model (or --split): that one configuration, a line per dataset and a summary line.\n"
+    "parameters (defaults: the library's):\n"
+    "  --model points|free-space|visibility   --split mean|sign|best\n"
+    "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
+    "  --band-low M  --band-high M  --min-group-size N  --ncut-threshold X  --threads N (0: all cores)\n"
+    "selection (defaults: all):\n"
+    "  --datasets office,loop,rooms20  --sensors laser360,laser180,depth  --poses exact,drift\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Configuration configuration;
+  std::optional<SensedSpaceModel> model;
+  std::optional<SplitCriterion> split;
+  std::string output;
+  std::vector<std::string> buildings = sim::buildingKeys();
+  std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
+  std::vector<PoseSource> pose_sources{PoseSource::Exact, PoseSource::Drift};
+  try {
+    RegionParameters& region = configuration.region;
+    using Setter = std::function<void(const std::string& flag, const std::string& value)>;
+    const auto number = [](double& target) -> Setter {
+      return [&target](const std::string& flag, const std::string& v) { target = parseNumber(flag, v); };
+    };
+    const auto integer = [](int& target) -> Setter {
+      return [&target](const std::string& flag, const std::string& v) { target = parseInteger(flag, v); };
+    };
+    const std::map<std::string, Setter> options{
+        {"--output", [&](const std::string&, const std::string& v) { output = v; }},
+        {"--model", [&](const std::string&, const std::string& v) { model = sensedSpaceModelFromString(v); }},
+        {"--split", [&](const std::string&, const std::string& v) { split = splitCriterionFromString(v); }},
+        {"--delta", number(configuration.match_distance)},
+        {"--cell", number(region.cell_size)},
+        {"--range", number(region.max_range)},
+        {"--clearance", number(region.clearance)},
+        {"--min-observations", integer(region.min_observations)},
+        {"--band-low", number(region.band_low)},
+        {"--band-high", number(region.band_high)},
+        {"--min-group-size", integer(configuration.min_group_size)},
+        {"--ncut-threshold", number(configuration.ncut_threshold)},
+        {"--threads", integer(configuration.threads)},
+        {"--datasets",
+         [&](const std::string&, const std::string& v) {
+           buildings = splitList(v);
+           for (const auto& key : buildings) sim::makeBuilding(key);  // reject unknown keys before any work
+         }},
+        {"--sensors",
+         [&](const std::string&, const std::string& v) {
+           sensors.clear();
+           for (const auto& name : splitList(v)) sensors.push_back(sim::sensorFromString(name));
+         }},
+        {"--poses",
+         [&](const std::string&, const std::string& v) {
+           pose_sources.clear();
+           for (const auto& name : splitList(v)) pose_sources.push_back(poseSourceFromString(name));
+         }},
+    };
+    for (int a = 1; a < argc; ++a) {
+      const std::string flag = argv[a];
+      if (flag == "--help" || flag == "-h") {
+        std::cout << kUsage;
+        return 0;
+      }
+      const auto it = options.find(flag);
+      if (it == options.end() || a + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + flag);
+      it->second(flag, argv[++a]);
+    }
+    if ((model || split) && !output.empty())
+      throw std::invalid_argument("--output writes the page; it takes no --model or --split");
+    if (buildings.empty() || sensors.empty() || pose_sources.empty()) throw std::invalid_argument("nothing selected");
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n" << kUsage;
+    return 2;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<Dataset> datasets = makeDatasets(buildings, sensors, pose_sources);
+  const double generation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  if (model || split) {
+    configuration.model = model.value_or(SensedSpaceModel::Points);
+    configuration.split = split.value_or(SplitCriterion::Mean);
+    std::cout << format("# %zu datasets generated in %.1f s\n", datasets.size(), generation_seconds);
+    return evaluateOneConfiguration(datasets, configuration);
+  }
+
+  std::vector<Configuration> configurations;
+  for (SensedSpaceModel m : {SensedSpaceModel::Points, SensedSpaceModel::FreeSpace, SensedSpaceModel::Visibility})
+    for (SplitCriterion s : {SplitCriterion::Mean, SplitCriterion::BestNcut}) {
+      Configuration c = configuration;
+      c.model = m;
+      c.split = s;
+      configurations.push_back(c);
+    }
+  const std::string report = page(datasets, configurations, generation_seconds);
+  if (output.empty()) {
+    std::cout << report;
+    return 0;
+  }
+  return writeGeneratedSection(output, report);
+}

@@ -1,0 +1,144 @@
+#include "scenarios.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <stdexcept>
+#include <utility>
+
+namespace obsgroup::sim {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+Building makeBuilding(const std::string& key) {
+  if (key == "office") return {key, "Office: a corridor and four rooms", office(), officeRoute(150)};
+  if (key == "loop")
+    return {key, "Building with a loop: a corridor ring around six rooms", loopBuilding(), loopBuildingRoute(300)};
+  if (key == "rooms20")
+    return {key, "Twenty rooms around a loop: a corridor ring, rooms inside and outside it", twentyRoomBuilding(),
+            twentyRoomBuildingRoute(600)};
+  throw std::invalid_argument("unknown building '" + key + "' (office, loop or rooms20)");
+}
+
+std::vector<std::string> buildingKeys() { return {"office", "loop", "rooms20"}; }
+
+std::string toString(Sensor sensor) {
+  switch (sensor) {
+    case Sensor::Laser360: return "laser360";
+    case Sensor::Laser180: return "laser180";
+    case Sensor::Depth: return "depth";
+  }
+  return "?";
+}
+
+Sensor sensorFromString(const std::string& name) {
+  for (Sensor s : {Sensor::Laser360, Sensor::Laser180, Sensor::Depth})
+    if (toString(s) == name) return s;
+  throw std::invalid_argument("unknown sensor '" + name + "' (laser360, laser180 or depth)");
+}
+
+std::string describe(Sensor sensor) {
+  switch (sensor) {
+    case Sensor::Laser360: return "360° laser";
+    case Sensor::Laser180: return "forward 180° laser";
+    case Sensor::Depth: return "depth camera";
+  }
+  return "?";
+}
+
+LaserModel laser360() {
+  LaserModel laser = fullTurnLaser(720);
+  laser.range_noise = 0.01;
+  return laser;
+}
+
+LaserModel laser180() {
+  LaserModel laser;
+  laser.range_noise = 0.01;
+  return laser;
+}
+
+DepthCamera depthCamera() {
+  DepthCamera camera;
+  camera.range_noise = 0.01;
+  return camera;
+}
+
+Places placesAlong(const FloorPlan& plan, const std::vector<Pose2D>& route, double stretch_length) {
+  // Each (room, stretch) met along the route becomes a place, numbered in
+  // the order of the plan's rooms so that the labels do not depend on the route.
+  std::map<std::pair<int, int>, int> place_of_key;
+  std::vector<std::pair<int, int>> keys;
+  std::vector<int> stretches_of_room(plan.rooms().size(), 1);
+  keys.reserve(route.size());
+  for (const Pose2D& pose : route) {
+    const int room = plan.roomAt(pose.x, pose.y);
+    int stretch = 0;
+    if (room >= 0 && plan.roomNames()[room].find("corridor") != std::string::npos) {
+      const FloorPlan::Room& box = plan.rooms()[room];
+      const bool along_x = box.x1 - box.x0 >= box.y1 - box.y0;
+      const double start = along_x ? box.x0 : box.y0, length = along_x ? box.x1 - box.x0 : box.y1 - box.y0;
+      const int count = std::max(1, static_cast<int>(std::lround(length / stretch_length)));
+      stretches_of_room[room] = count;
+      const double position = (along_x ? pose.x : pose.y) - start;
+      stretch = std::clamp(static_cast<int>(std::floor(position / (length / count))), 0, count - 1);
+    }
+    keys.emplace_back(room, stretch);
+    place_of_key[keys.back()] = 0;
+  }
+  Places places;
+  for (auto& [key, place] : place_of_key) {  // std::map: room -1 first, then the plan's order
+    place = static_cast<int>(places.names.size());
+    const auto [room, stretch] = key;
+    if (room < 0) {
+      places.names.push_back("(outside every room)");
+      places.is_room.push_back(false);
+    } else if (plan.roomNames()[room].find("corridor") != std::string::npos) {
+      places.names.push_back(plan.roomNames()[room] + " " + std::to_string(stretch + 1) + "/" +
+                             std::to_string(stretches_of_room[room]));
+      places.is_room.push_back(false);
+    } else {
+      places.names.push_back(plan.roomNames()[room]);
+      places.is_room.push_back(true);
+    }
+  }
+  for (const auto& key : keys) places.of_pose.push_back(place_of_key.at(key));
+  return places;
+}
+
+Eigen::Isometry3d toIsometry(const Pose2D& pose, double z) {
+  Eigen::Isometry3d isometry = Eigen::Isometry3d::Identity();
+  isometry.translation() << pose.x, pose.y, z;
+  isometry.linear() = Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return isometry;
+}
+
+std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed) {
+  if (truth.empty()) return {};
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Isometry3d> out{truth.front()};
+  for (std::size_t k = 1; k < truth.size(); ++k) {
+    const Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
+    const double length = step.translation().norm();
+    // Drawn one at a time so that the order, hence the numbers, do not depend on the compiler.
+    const double dx = 0.02 * length * unit(rng);
+    const double dy = 0.02 * length * unit(rng);
+    const double dyaw = (kPi / 180.0) * length * unit(rng);
+    out.push_back(out.back() * step * toIsometry({dx, dy, dyaw}));
+  }
+  return out;
+}
+
+double rmsPositionError(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b) {
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n == 0) return 0.0;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < n; ++k) sum += (a[k].translation() - b[k].translation()).squaredNorm();
+  return std::sqrt(sum / double(n));
+}
+
+}  // namespace obsgroup::sim
