@@ -162,14 +162,19 @@ struct Configuration {
   double match_distance = 0.1;  ///< delta of the points model: the paper's
   RegionParameters region;      ///< of the free-space and visibility models
   int min_group_size = 1;
-  double ncut_threshold = 1.0;  ///< the paper's
+  double ncut_threshold = ObservationGrouping<pcl::PointXYZ>::kDefaultNcutThreshold;
   int threads = 0;  ///< 0: all cores
 
   /// The page's row label: the model (with δ for points) and the split; the
   /// region parameters are common to all rows and stated once.
   std::string label() const {
     const std::string delta = model == SensedSpaceModel::Points ? format(" δ %g m", match_distance) : std::string();
-    return toString(model) + delta + ", split " + toString(split);
+    const bool paper = model == SensedSpaceModel::Points && split == SplitCriterion::Mean && ncut_threshold == 1.0;
+    const ObservationGrouping<pcl::PointXYZ> defaults;
+    const bool library_default = model == defaults.getSensedSpaceModel() && split == defaults.getSplitCriterion() &&
+                                 ncut_threshold == defaults.getNcutThreshold();
+    return toString(model) + delta + ", split " + toString(split) + format(", Ncut < %g", ncut_threshold) +
+           (paper ? " (the paper)" : "") + (library_default ? " (**the default**)" : "");
   }
 
   /// Every parameter, for the summary line of a sweep.
@@ -440,8 +445,8 @@ std::vector<std::string> splitList(const std::string& text) {
 const char* kUsage =
     "usage: evaluate_grouping [--output FILE] [parameters] [selection]\n"
     "       evaluate_grouping --model M [--split S] [parameters] [selection]\n"
-    "Without --model: the page's six configurations (points, free-space, visibility; split mean and best).\n"
-    "With --model (or --split): that one configuration, a line per dataset and a summary line.\n"
+    "Without --model: the page's twelve configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's).\n"
+    "With --model or --split: that one configuration (unset: the library's default), a line per dataset and a summary line.\n"
     "parameters (defaults: the library's):\n"
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
@@ -521,20 +526,24 @@ int main(int argc, char** argv) {
   const double generation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (model || split) {
-    configuration.model = model.value_or(SensedSpaceModel::Points);
-    configuration.split = split.value_or(SplitCriterion::Mean);
+    const ObservationGrouping<pcl::PointXYZ> defaults;
+    configuration.model = model.value_or(defaults.getSensedSpaceModel());
+    configuration.split = split.value_or(defaults.getSplitCriterion());
     std::cout << format("# %zu datasets generated in %.1f s\n", datasets.size(), generation_seconds);
     return evaluateOneConfiguration(datasets, configuration);
   }
 
   std::vector<Configuration> configurations;
+  // Every model with each split, at the paper's threshold and the default's.
   for (SensedSpaceModel m : {SensedSpaceModel::Points, SensedSpaceModel::FreeSpace, SensedSpaceModel::Visibility})
-    for (SplitCriterion s : {SplitCriterion::Mean, SplitCriterion::BestNcut}) {
-      Configuration c = configuration;
-      c.model = m;
-      c.split = s;
-      configurations.push_back(c);
-    }
+    for (double threshold : {1.0, ObservationGrouping<pcl::PointXYZ>::kDefaultNcutThreshold})
+      for (SplitCriterion s : {SplitCriterion::Mean, SplitCriterion::BestNcut}) {
+        Configuration c = configuration;
+        c.model = m;
+        c.split = s;
+        c.ncut_threshold = threshold;
+        configurations.push_back(c);
+      }
   const std::string report = page(datasets, configurations, generation_seconds);
   if (output.empty()) {
     std::cout << report;

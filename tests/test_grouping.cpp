@@ -11,7 +11,7 @@ TEST(ObservationGrouping, ParametersRoundTrip) {
   ObservationGrouping<pcl::PointXYZI> g;
   EXPECT_DOUBLE_EQ(g.getMatchDistance(), 0.1);
   EXPECT_DOUBLE_EQ(g.getVoxelLeafSize(), 0.0);
-  EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 1.0);
+  EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 0.7);
   EXPECT_DOUBLE_EQ(g.getDiagonalWeight(), 0.0);
   // The measured defaults (docs/grouping.md), and the paper's on request.
   EXPECT_EQ(g.getSensedSpaceModel(), SensedSpaceModel::Visibility);
@@ -19,6 +19,7 @@ TEST(ObservationGrouping, ParametersRoundTrip) {
   g.usePaperMethod();
   EXPECT_EQ(g.getSensedSpaceModel(), SensedSpaceModel::Points);
   EXPECT_EQ(g.getSplitCriterion(), SplitCriterion::Mean);
+  EXPECT_DOUBLE_EQ(g.getNcutThreshold(), 1.0);
   EXPECT_EQ(g.getMinGroupSize(), 1);
   EXPECT_EQ(g.getNeighbourSearch(), NeighbourSearch::SharedGrid);
   g.setMatchDistance(0.2);

@@ -47,13 +47,19 @@ class ObservationGrouping {
   ObservationGrouping() {
     overlap_.setSensedSpaceModel(SensedSpaceModel::Visibility);
     options_.split = SplitCriterion::BestNcut;
+    options_.ncut_threshold = kDefaultNcutThreshold;
   }
 
-  /// The paper's method exactly: the points model of eq. (16)-(18) and the
-  /// mean split of sec. II-A (delta and the Ncut threshold as set).
+  /// The Ncut threshold of the defaults: the paper's 1 splits any group whose
+  /// overlap is not uniform (see docs/method.md); 0.7 keeps rooms whole.
+  static constexpr double kDefaultNcutThreshold = 0.7;
+
+  /// The paper's method exactly: the points model of eq. (16)-(18), the mean
+  /// split of sec. II-A and the Ncut threshold 1 of sec. II-B (delta as set).
   void usePaperMethod() {
     overlap_.setSensedSpaceModel(SensedSpaceModel::Points);
     options_.split = SplitCriterion::Mean;
+    options_.ncut_threshold = 1.0;
   }
 
   /// Adds an observation: points in the sensor frame and the sensor's pose.

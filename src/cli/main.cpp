@@ -72,7 +72,7 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->transform(CLI::CheckedTransformer(models))
       ->group("Method");
   command.add_flag("--paper", paper,
-                   "the paper's method exactly: --sso points --split mean (delta, threshold as given)")
+                   "the paper's method exactly: --sso points --split mean --ncut-threshold 1 (delta as given)")
       ->group("Method");
   command.add_option("--cell", args.region.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(CLI::PositiveNumber)
@@ -176,8 +176,11 @@ int main(int argc, char** argv) {
       return usage("--paper uses --sso points; drop one of them");
     if (partition->count("--split") && args.split != obsgroup::SplitCriterion::Mean)
       return usage("--paper uses --split mean; drop one of them");
+    if (partition->count("--ncut-threshold") && args.ncut_threshold != 1.0)
+      return usage("--paper uses --ncut-threshold 1; drop one of them");
     args.sso = obsgroup::SensedSpaceModel::Points;
     args.split = obsgroup::SplitCriterion::Mean;
+    args.ncut_threshold = 1.0;
   }
   const bool points = args.sso == obsgroup::SensedSpaceModel::Points;
   for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})

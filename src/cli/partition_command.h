@@ -33,7 +33,7 @@ struct PartitionArgs {
   RegionParameters region;  ///< free-space and visibility models
   double delta = 0.1;
   double voxel = 0.0;
-  double ncut_threshold = 1.0;
+  double ncut_threshold = 0.7;  ///< ObservationGrouping::kDefaultNcutThreshold
   SplitCriterion split = SplitCriterion::BestNcut;
   int min_group_size = 1;
   std::optional<int> max_depth;

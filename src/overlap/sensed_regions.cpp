@@ -106,6 +106,14 @@ class RegionMarker {
     const std::uint64_t b = offset(c);
     bits_[b >> 6] |= std::uint64_t(1) << (b & 63);
   }
+  /// Whether a cell is marked (cells outside the box are not).
+  bool marked(const Cell<D>& c) const {
+    for (int a = 0; a < D; ++a)
+      if (c[a] < lo_[a] || c[a] >= lo_[a] + extent_[a]) return false;
+    if (!dense_) return std::find(keys_.begin(), keys_.end(), keyOf<D>(c)) != keys_.end();
+    const std::uint64_t b = offset(c);
+    return bits_[b >> 6] >> (b & 63) & 1;
+  }
   /// Appends the marked keys, ascending.
   void emit(std::vector<std::uint64_t>& out) {
     if (!dense_) {
@@ -335,25 +343,45 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
 /// fixed set of world angles (so the heading plays no part), each stopped by
 /// the first occupied cell it enters beyond the clearance, that cell included.
 void visibilityOf(const WorldPoints& world, int i, const Eigen::Vector3d& origin, const RegionParameters& params,
-                  const CellGrid& grid, OccupancyGrid::Reader& occupancy, RegionMarker<2>& marker,
-                  std::vector<std::uint64_t>& out) {
+                  const CellGrid& grid, bool planar, OccupancyGrid::Reader& occupancy, RegionMarker<2>& own,
+                  RegionMarker<2>& marker, std::vector<std::uint64_t>& out) {
   if (world.count(i) == 0) return;  // an observation with no point sensed nothing
   const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
   const auto o = grid.inCells<2>(origin);
   const auto [lo, hi] = boxAround<2>(o, range);
-  marker.reset(lo, hi);
+  // The observation's own surfaces block its view even where too few others
+  // saw them to make them occupied: its points agree with its own pose. A
+  // ray's direction is covered when one of its points lies that way.
   // Adjacent rays at most one cell apart at full range.
-  const int rays = std::max(64, int(std::ceil(2.0 * 3.14159265358979323846 * range)));
+  const double kTwoPi = 2.0 * 3.14159265358979323846;
+  const int rays = std::max(64, int(std::ceil(kTwoPi * range)));
+  std::vector<char> covered(rays, 0);
+  own.reset(lo, hi);
+  for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
+    if (inBand(*p, origin, params, planar)) {
+      const auto e = grid.inCells<2>(p->cast<double>());
+      const Cell<2> c = cellOf<2>(e);
+      if (c[0] >= lo[0] && c[0] <= hi[0] && c[1] >= lo[1] && c[1] <= hi[1]) own.mark(c);
+      double angle = std::atan2(e[1] - o[1], e[0] - o[0]);
+      if (angle < 0) angle += kTwoPi;
+      covered[std::min(rays - 1, int(std::lround(angle / kTwoPi * rays)) % rays)] = 1;
+    }
+  marker.reset(lo, hi);
   for (int r = 0; r < rays; ++r) {
-    const double angle = 2.0 * 3.14159265358979323846 * r / rays;
+    const double angle = kTwoPi * r / rays;
     const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
+    // Where the observation looked, its own beams say what it saw: only its
+    // own surfaces stop the ray, so drifted copies of other observations'
+    // walls do not cut its view. Elsewhere (behind a forward laser, beside
+    // a camera) the occupancy of all observations stands in for its eyes.
+    const bool own_view = covered[r];
     // Only the occupied cells a ray starts among are passed, and only
     // within the clearance: once it has crossed a free cell, the next
     // occupied cell is a wall seen from inside and stops it.
     bool crossed_free = false;
     traverse<2>(o, end, [&](const Cell<2>& c, double t) {
       marker.mark(c);
-      if (!occupancy.occupied(c)) return crossed_free = true;
+      if (!own.marked(c) && (own_view || !occupancy.occupied(c))) return crossed_free = true;
       return !crossed_free && t < clear;
     });
   }
@@ -447,7 +475,7 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   FirstError error;
 #pragma omp parallel num_threads(threads)
   {
-    RegionMarker<2> marker2;
+    RegionMarker<2> marker2, own_surfaces;
     RegionMarker<3> marker3;
     OccupancyGrid::Reader reader(grid);
 #pragma omp for schedule(dynamic, 8)
@@ -455,7 +483,8 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
       if (interruptRequested(interrupt)) continue;
       try {
         if (model == SensedSpaceModel::Visibility)
-          visibilityOf(world, i, sensor_origins[i], params, cells, reader, marker2, per_observation[i]);
+          visibilityOf(world, i, sensor_origins[i], params, cells, regions.planar, reader, own_surfaces, marker2,
+                       per_observation[i]);
         else if (volumetric)
           freeSpaceOf<3>(world, i, sensor_origins[i], params, cells, marker3, per_observation[i]);
         else

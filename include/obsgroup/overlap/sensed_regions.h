@@ -37,19 +37,24 @@ std::string toString(SensedSpaceModel model);
 /// Parses "points", "free-space" or "visibility"; throws std::invalid_argument otherwise.
 SensedSpaceModel sensedSpaceModelFromString(const std::string& name);
 
-/// Parameters of the region models (free space, visibility).
+/// Parameters of the region models (free space, visibility). The defaults
+/// measured best across 2D lasers and depth cameras, exact and drifted poses
+/// (docs/grouping.md).
 struct RegionParameters {
   /// Edge of a grid cell (2D) or voxel (3D), metres.
-  double cell_size = 0.25;
-  /// Beams are followed, and visibility is cast, this far from the sensor, metres.
-  double max_range = 10.0;
+  double cell_size = 0.2;
+  /// Beams are followed, and visibility is cast, this far from the sensor,
+  /// metres: about a room's size, so that a long corridor is cut into
+  /// stretches and a view through a door reaches only the near part of the
+  /// next room.
+  double max_range = 6.0;
   /// Visibility: occupied cells closer than this to the pose do not block
   /// (a drifted pose next to a wall, or inside its cell, still sees), metres.
   double clearance = 0.3;
   /// Visibility: a cell is occupied when at least this many observations
   /// have a point in it (1: any point). Drifted copies of a wall that one
   /// observation alone put across a door then do not close it.
-  int min_observations = 1;
+  int min_observations = 2;
   /// Visibility in 3D: the points whose height above the sensor lies in
   /// [band_low, band_high] make the occupancy grid (a depth camera at 1 m
   /// over the floor: 0.3 to 1.8 m above the floor), metres.
