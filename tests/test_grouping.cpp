@@ -60,6 +60,7 @@ TEST(ObservationGrouping, PoseFromViewpointOfAPcdFile) {
 TEST(ObservationGrouping, WeightMatrixHasTheConfiguredDiagonal) {
   const auto obs = test::simulate<pcl::PointXYZ>(sim::threeRooms(), sim::threeRoomsPoses(2));
   ObservationGrouping<pcl::PointXYZ> g;
+  g.usePaperMethod();  // the diagonal is the paper's question (sec. III), asked of its method
   for (const auto& o : obs) g.addObservation(o.cloud, o.pose);
   g.compute();
   const WeightMatrix& W = g.getWeightMatrix();

@@ -88,7 +88,8 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->capture_default_str()
       ->group("Method");
   command.add_option("--min-observations", args.region.min_observations,
-                     "visibility: a cell is occupied when this many observations have a point in it")
+                     "visibility: a cell is occupied when this many observations have a point in it (and no more "
+                 "saw through it)")
       ->check(CLI::Range(1, 1 << 30))
       ->capture_default_str()
       ->group("Method");

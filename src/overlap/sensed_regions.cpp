@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <unordered_map>
@@ -96,6 +97,7 @@ class RegionMarker {
     }
     dense_ = total <= (std::uint64_t(1) << 26);
     keys_.clear();
+    removed_.clear();
     if (dense_) bits_.assign((total + 63) / 64, 0);
   }
   void mark(const Cell<D>& c) {
@@ -105,6 +107,18 @@ class RegionMarker {
     }
     const std::uint64_t b = offset(c);
     bits_[b >> 6] |= std::uint64_t(1) << (b & 63);
+  }
+  /// Clears a cell of the box (dense bitmaps; the sparse fallback drops it
+  /// when emitting). Cells outside the box are ignored.
+  void unmark(const Cell<D>& c) {
+    for (int a = 0; a < D; ++a)
+      if (c[a] < lo_[a] || c[a] >= lo_[a] + extent_[a]) return;
+    if (!dense_) {
+      removed_.push_back(keyOf<D>(c));
+      return;
+    }
+    const std::uint64_t b = offset(c);
+    bits_[b >> 6] &= ~(std::uint64_t(1) << (b & 63));
   }
   /// Whether a cell is marked (cells outside the box are not).
   bool marked(const Cell<D>& c) const {
@@ -119,7 +133,8 @@ class RegionMarker {
     if (!dense_) {
       std::sort(keys_.begin(), keys_.end());
       keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
-      out.insert(out.end(), keys_.begin(), keys_.end());
+      std::sort(removed_.begin(), removed_.end());
+      std::set_difference(keys_.begin(), keys_.end(), removed_.begin(), removed_.end(), std::back_inserter(out));
       return;
     }
     for (std::size_t w = 0; w < bits_.size(); ++w)
@@ -144,7 +159,7 @@ class RegionMarker {
   std::array<std::int64_t, D> extent_{};
   bool dense_ = true;
   std::vector<std::uint64_t> bits_;
-  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint64_t> keys_, removed_;
 };
 
 /// Visits the cells a segment from `from` to `to` (in cell units) crosses, in
@@ -305,36 +320,90 @@ bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, const Regio
 }
 
 /// The plane cells occupied by at least params.min_observations observations.
-std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins,
-                                         const RegionParameters& params, const CellGrid& grid, bool planar,
-                                         int threads) {
-  const int n = world.size();
-  std::vector<std::vector<std::uint64_t>> per_observation(n);
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
-  for (int i = 0; i < n; ++i) {
-    auto& keys = per_observation[i];
-    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
-      if (inBand(*p, origins[i], params, planar))
-        keys.push_back(keyOf<2>(cellOf<2>(grid.inCells<2>(p->cast<double>()))));
-    std::sort(keys.begin(), keys.end());
-    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  }
+/// Sorts integers in parallel: the same order whatever the threads.
+void sortKeys(std::vector<std::uint64_t>& keys) {
+#if defined(__GLIBCXX__) && defined(_OPENMP)
+  __gnu_parallel::sort(keys.begin(), keys.end());
+#else
+  std::sort(keys.begin(), keys.end());
+#endif
+}
+
+/// Concatenates per-observation key lists (freeing them) and sorts them.
+std::vector<std::uint64_t> gatherSorted(std::vector<std::vector<std::uint64_t>>& per_observation) {
+  std::size_t total = 0;
+  for (const auto& keys : per_observation) total += keys.size();
   std::vector<std::uint64_t> all;
+  all.reserve(total);
   for (auto& keys : per_observation) {
     all.insert(all.end(), keys.begin(), keys.end());
     std::vector<std::uint64_t>().swap(keys);
   }
-#if defined(__GLIBCXX__) && defined(_OPENMP)
-  __gnu_parallel::sort(all.begin(), all.end());  // integers: the same order whatever the threads
-#else
-  std::sort(all.begin(), all.end());
-#endif
+  sortKeys(all);
+  return all;
+}
+
+/// The plane cells occupied in the evidence of all observations: at least
+/// params.min_observations observations have a point in the cell, and at
+/// least as many have a point in it as have a beam through it. A wall seen
+/// once, by a sparse sequence, stands; a drifted copy of a wall across a door,
+/// which the beams of everyone passing the door cross, does not.
+std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins,
+                                         const RegionParameters& params, const CellGrid& grid, bool planar,
+                                         int threads) {
+  const int n = world.size();
+  const double range = params.max_range / grid.size;
+  std::vector<std::vector<std::uint64_t>> hit(n), crossed(n);
+#pragma omp parallel num_threads(threads)
+  {
+    RegionMarker<2> marker;
+    std::vector<Cell<2>> ends;
+    std::vector<std::array<double, 2>> targets;
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) {
+      if (world.count(i) == 0) continue;
+      ends.clear();
+      targets.clear();
+      const auto o = grid.inCells<2>(origins[i]);
+      Cell<2> lo = cellOf<2>(o), hi = lo;
+      for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+        if (!inBand(*p, origins[i], params, planar)) continue;
+        std::array<double, 2> e = grid.inCells<2>(p->cast<double>());
+        ends.push_back(cellOf<2>(e));
+        // The beam counts as seeing through the cells it crosses within range.
+        const double length = std::hypot(e[0] - o[0], e[1] - o[1]);
+        if (length > range)
+          for (int a = 0; a < 2; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+        targets.push_back(e);
+        const Cell<2> t = cellOf<2>(e);
+        for (int a = 0; a < 2; ++a)
+          lo[a] = std::min({lo[a], t[a], ends.back()[a]}), hi[a] = std::max({hi[a], t[a], ends.back()[a]});
+      }
+      marker.reset(lo, hi);
+      for (const Cell<2>& c : ends) marker.mark(c);
+      marker.emit(hit[i]);
+      marker.reset(lo, hi);
+      for (const auto& e : targets)
+        traverse<2>(o, e, [&](const Cell<2>& c, double) {
+          marker.mark(c);
+          return true;
+        });
+      for (const Cell<2>& c : ends) marker.unmark(c);  // a surface it saw is not a cell it saw through
+      marker.emit(crossed[i]);
+    }
+  }
+  const std::vector<std::uint64_t> hits = gatherSorted(hit), misses = gatherSorted(crossed);
   std::vector<std::uint64_t> occupied;
-  for (std::size_t a = 0; a < all.size();) {
+  std::size_t m = 0;
+  for (std::size_t a = 0; a < hits.size();) {
     std::size_t b = a;
-    while (b < all.size() && all[b] == all[a]) ++b;
-    if (b - a >= std::size_t(params.min_observations)) occupied.push_back(all[a]);
+    while (b < hits.size() && hits[b] == hits[a]) ++b;
+    while (m < misses.size() && misses[m] < hits[a]) ++m;
+    std::size_t e = m;
+    while (e < misses.size() && misses[e] == hits[a]) ++e;
+    if (b - a >= std::size_t(params.min_observations) && b - a >= e - m) occupied.push_back(hits[a]);
     a = b;
+    m = e;
   }
   return occupied;
 }

@@ -52,9 +52,10 @@ struct RegionParameters {
   /// (a drifted pose next to a wall, or inside its cell, still sees), metres.
   double clearance = 0.3;
   /// Visibility: a cell is occupied when at least this many observations
-  /// have a point in it (1: any point). Drifted copies of a wall that one
-  /// observation alone put across a door then do not close it.
-  int min_observations = 2;
+  /// have a point in it, and no fewer than have a beam through it: a drifted
+  /// copy of a wall across a door, which the beams of everyone who looked
+  /// through the door cross, does not close it; a wall seen once stands.
+  int min_observations = 1;
   /// Visibility in 3D: the points whose height above the sensor lies in
   /// [band_low, band_high] make the occupancy grid (a depth camera at 1 m
   /// over the floor: 0.3 to 1.8 m above the floor), metres.
