@@ -92,6 +92,12 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
                                   const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,
                                   int threads = 0, const InterruptFlag* interrupt = nullptr);
 
+/// Pi and Psi of the regions of `model`, as regionOverlap(computeRegions(...))
+/// but without ever holding the regions twice (what SensedSpaceOverlap uses).
+OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& world,
+                                   const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,
+                                   int threads = 0, const InterruptFlag* interrupt = nullptr);
+
 /// For every observation i and every j != i, the number of cells of i's
 /// region that j's region holds (the numerator of Pi).
 MatchCounts countSharedCells(const ObservationRegions& regions, int threads = 0,

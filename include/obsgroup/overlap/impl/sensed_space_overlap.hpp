@@ -188,7 +188,9 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
   const WorldPoints world = toWorld(observations);
   if (model_ != SensedSpaceModel::Points) {
     if (progress_) progress_(0, observations.size());
-    OverlapResult result = regionOverlap(computeRegions(observations, world), threads_, interrupt_);
+    std::vector<Eigen::Vector3d> origins(observations.size());
+    for (std::size_t i = 0; i < observations.size(); ++i) origins[i] = observations[i].pose.translation() - world.origin;
+    OverlapResult result = computeRegionOverlap(model_, world, origins, region_, threads_, interrupt_);
     result.region_cells = std::move(result.points_per_observation);
     result.points_per_observation.resize(observations.size());
     for (int i = 0; i < world.size(); ++i) result.points_per_observation[i] = world.count(i);
