@@ -283,6 +283,32 @@ TEST(SensedRegions, MinObservationsKeepsADoorOpenAgainstOneDriftedScan) {
   EXPECT_EQ(own_walls.region_cells[0], clean.region_cells[0]);
 }
 
+TEST(SensedRegions, BeamsThroughADoorOutvoteADriftedWallAcrossIt) {
+  // A forward laser in the west room with its back to the door: towards the
+  // door it did not look, so the shared occupancy decides what it sees there.
+  const auto plan = twoRooms(true);
+  const Obs back_to_door = scanAt(plan, {4.5, 2.5, kPi});
+  const Obs east = scanAt(plan, kEastMiddle, allAround());
+  // A scan whose pose drifted 1 m north: its copy of the dividing wall's
+  // southern piece (y 0 to 2) lies across the door (y 2 to 3).
+  Obs drifted = scanAt(plan, {4.5, 2.55, 0.0}, allAround());
+  drifted.pose = pose2D(4.5, 3.55, 0.0);
+  // Two scans of the west room looking east, through the door.
+  const Obs through_a = scanAt(plan, {3.0, 2.5, 0.0}), through_b = scanAt(plan, {2.0, 2.4, 0.0});
+
+  const OverlapResult clean = overlap({back_to_door, east, through_a, through_b}, SensedSpaceModel::Visibility);
+  const OverlapResult closed = overlap({back_to_door, east, drifted}, SensedSpaceModel::Visibility);
+  const OverlapResult open =
+      overlap({back_to_door, east, drifted, through_a, through_b}, SensedSpaceModel::Visibility);
+  // Alone against the east scan's beams through the door, the copy closes
+  // part of it; against the beams of two more that looked through the door
+  // it is outvoted, and the view of the scan with its back to the door
+  // reaches into the east room as if the copy were not there.
+  EXPECT_GT(pi(open, 0, 1), pi(closed, 0, 1) + 0.1) << pi(open, 0, 1) << " " << pi(closed, 0, 1);
+  EXPECT_GT(open.region_cells[0], closed.region_cells[0]);
+  EXPECT_GE(pi(open, 0, 1), 0.9 * pi(clean, 0, 1)) << pi(open, 0, 1) << " " << pi(clean, 0, 1);
+}
+
 // --- 3. clearance -------------------------------------------------------------
 
 TEST(SensedRegions, ClearanceLetsAPoseInAWallCellSee) {
