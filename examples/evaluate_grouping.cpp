@@ -197,26 +197,6 @@ struct Result {
   std::string error;  ///< what compute() threw; the numbers are then meaningless
 };
 
-/// Adjusted Rand index of two labellings (Hubert and Arabie): 1 when they
-/// are the same partition, about 0 for a chance agreement.
-double adjustedRandIndex(const std::vector<int>& a, const std::vector<int>& b) {
-  std::map<std::pair<int, int>, double> table;
-  std::map<int, double> rows, cols;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    table[{a[i], b[i]}] += 1;
-    rows[a[i]] += 1;
-    cols[b[i]] += 1;
-  }
-  const auto pairs = [](double n) { return n * (n - 1) / 2; };
-  double index = 0, sum_rows = 0, sum_cols = 0;
-  for (const auto& [key, n] : table) index += pairs(n);
-  for (const auto& [key, n] : rows) sum_rows += pairs(n);
-  for (const auto& [key, n] : cols) sum_cols += pairs(n);
-  const double expected = sum_rows * sum_cols / pairs(double(a.size()));
-  const double maximum = (sum_rows + sum_cols) / 2;
-  return maximum == expected ? 0.0 : (index - expected) / (maximum - expected);
-}
-
 Result evaluate(const Dataset& d, const Configuration& c) {
   Result r;
   r.rooms = d.rooms;
@@ -244,7 +224,7 @@ Result evaluate(const Dataset& d, const Configuration& c) {
   r.warnings = grouping.getWarnings().size();
   r.groups = static_cast<int>(p.groups.size());
   r.mean_group_size = r.groups ? double(d.observations.size()) / r.groups : 0.0;
-  r.ari = adjustedRandIndex(d.places.of_pose, p.group_of);
+  r.ari = sim::adjustedRandIndex(d.places.of_pose, p.group_of);
   std::map<int, std::set<int>> groups_of_room;
   for (std::size_t i = 0; i < d.places.of_pose.size(); ++i)
     if (d.places.is_room[d.places.of_pose[i]]) groups_of_room[d.places.of_pose[i]].insert(p.group_of[i]);

@@ -15,6 +15,7 @@
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
 
 #include "floor_plan.h"
+#include "scenarios.h"
 #include "to_cloud.h"
 
 #include <obsgroup/maps/local_map_builder.h>
@@ -59,30 +60,12 @@ struct Dataset {
   std::vector<Eigen::Isometry3d> held_out_truth;
 };
 
-Eigen::Isometry3d toIsometry(const sim::Pose2D& p) { return pose2D(p.x, p.y, p.yaw); }
-
-/// Odometry-like drift: each step's motion is perturbed by about 2% of its
-/// length in translation and 1 degree per metre in heading.
-std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> unit(0.0, 1.0);
-  std::vector<Eigen::Isometry3d> out{truth.front()};
-  for (std::size_t k = 1; k < truth.size(); ++k) {
-    const Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
-    const double length = step.translation().norm();
-    const Eigen::Isometry3d error =
-        pose2D(0.02 * length * unit(rng), 0.02 * length * unit(rng), (kPi / 180.0) * length * unit(rng));
-    out.push_back(out.back() * step * error);
-  }
-  return out;
-}
-
 Dataset makeDataset(const Scenario& s) {
   sim::LaserModel laser;  // 180 degrees, 361 beams, 30 m
   laser.range_noise = 0.01;
   Dataset d;
-  for (std::size_t k = 0; k < s.route.size(); ++k) d.truth.push_back(toIsometry(s.route[k]));
-  const auto drifted = drift(d.truth, 7);
+  for (std::size_t k = 0; k < s.route.size(); ++k) d.truth.push_back(sim::toIsometry(s.route[k]));
+  const auto drifted = sim::drift(d.truth, 7);
   for (std::size_t k = 0; k < s.route.size(); ++k) {
     d.drifted.push_back({sim::toCloud<pcl::PointXYZ>(sim::scanToPoints(s.plan.scan(s.route[k], laser, k), laser)),
                          drifted[k]});
@@ -94,7 +77,7 @@ Dataset makeDataset(const Scenario& s) {
     const sim::Pose2D& b = s.route[k + 1];
     const sim::Pose2D mid{(a.x + b.x) / 2, (a.y + b.y) / 2, std::atan2(std::sin(a.yaw) + std::sin(b.yaw), std::cos(a.yaw) + std::cos(b.yaw))};
     d.held_out.push_back(sim::toCloud<pcl::PointXYZ>(sim::scanToPoints(s.plan.scan(mid, laser, 100000 + k), laser)));
-    d.held_out_truth.push_back(toIsometry(mid));
+    d.held_out_truth.push_back(sim::toIsometry(mid));
   }
   return d;
 }
@@ -111,24 +94,6 @@ Partition fromGroups(std::vector<std::vector<int>> groups, int n) {
   for (std::size_t g = 0; g < p.groups.size(); ++g)
     for (int i : p.groups[g]) p.group_of[i] = static_cast<int>(g);
   return p;
-}
-
-double adjustedRandIndex(const std::vector<int>& a, const std::vector<int>& b) {
-  std::map<std::pair<int, int>, double> table;
-  std::map<int, double> rows, cols;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    table[{a[i], b[i]}] += 1;
-    rows[a[i]] += 1;
-    cols[b[i]] += 1;
-  }
-  const auto pairs = [](double n) { return n * (n - 1) / 2; };
-  double index = 0, sum_rows = 0, sum_cols = 0;
-  for (const auto& [key, n] : table) index += pairs(n);
-  for (const auto& [key, n] : rows) sum_rows += pairs(n);
-  for (const auto& [key, n] : cols) sum_cols += pairs(n);
-  const double expected = sum_rows * sum_cols / pairs(double(a.size()));
-  const double maximum = (sum_rows + sum_cols) / 2;
-  return maximum == expected ? 0.0 : (index - expected) / (maximum - expected);
 }
 
 Cloud::Ptr moved(const Cloud& cloud, const Eigen::Isometry3d& pose) {
@@ -225,7 +190,7 @@ void localization(const Dataset& d, const std::vector<LocalMap<pcl::PointXYZ>>& 
 }
 
 void rooms(const Dataset& d, const Partition& p, Row& row) {
-  row.ari = adjustedRandIndex(d.room, p.group_of);
+  row.ari = sim::adjustedRandIndex(d.room, p.group_of);
   std::map<int, std::set<int>> groups_of_room;
   for (std::size_t i = 0; i < d.room.size(); ++i) groups_of_room[d.room[i]].insert(p.group_of[i]);
   row.rooms = static_cast<int>(groups_of_room.size());

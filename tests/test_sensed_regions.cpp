@@ -5,6 +5,7 @@
 // centre), so the first pose of each scene below is chosen with every wall
 // face well inside a cell: no answer hangs on a point lying exactly on a
 // cell edge.
+#include "scenarios.h"
 #include "test_support.h"
 
 #include <obsgroup/observation_grouping.h>
@@ -97,24 +98,23 @@ std::vector<Obs> depthViews(const sim::FloorPlan& plan, const std::vector<sim::P
   return out;
 }
 
-OverlapResult overlap(const std::vector<Obs>& obs, SensedSpaceModel model,
-                      const RegionParameters& params = sceneParameters(),
-                      int threads = 0) {
+SensedSpaceOverlap<Point> configured(SensedSpaceModel model, const RegionParameters& params, int threads) {
   SensedSpaceOverlap<Point> sso;
   sso.setSensedSpaceModel(model);
   sso.setRegionParameters(params);
   sso.setNumberOfThreads(threads);
-  return sso.compute(obs);
+  return sso;
+}
+
+OverlapResult overlap(const std::vector<Obs>& obs, SensedSpaceModel model,
+                      const RegionParameters& params = sceneParameters(), int threads = 0) {
+  return configured(model, params, threads).compute(obs);
 }
 
 /// The regions SensedSpaceOverlap measures the overlap of.
 ObservationRegions regionsOf(const std::vector<Obs>& obs, SensedSpaceModel model,
-                             const RegionParameters& params = sceneParameters(),
-                             int threads = 0) {
-  SensedSpaceOverlap<Point> sso;
-  sso.setSensedSpaceModel(model);
-  sso.setRegionParameters(params);
-  sso.setNumberOfThreads(threads);
+                             const RegionParameters& params = sceneParameters(), int threads = 0) {
+  const SensedSpaceOverlap<Point> sso = configured(model, params, threads);
   return sso.computeRegions(obs, sso.toWorld(obs));
 }
 
@@ -133,23 +133,6 @@ void expectSameMatrix(const OverlapResult& a, const OverlapResult& b) {
     EXPECT_EQ(a.pairs[k].j, b.pairs[k].j);
     EXPECT_EQ(a.pairs[k].weight, b.pairs[k].weight);
   }
-}
-
-/// Odometry-like drift, as in examples/evaluate_local_maps.cpp: each step's
-/// motion perturbed by 2% of its length in x and y and 1 degree per metre in
-/// heading.
-std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> unit(0.0, 1.0);
-  std::vector<Eigen::Isometry3d> out{truth.front()};
-  for (std::size_t k = 1; k < truth.size(); ++k) {
-    const Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
-    const double length = step.translation().norm();
-    const double dx = 0.02 * length * unit(rng), dy = 0.02 * length * unit(rng);
-    const double dyaw = (kPi / 180.0) * length * unit(rng);
-    out.push_back(out.back() * step * pose2D(dx, dy, dyaw));
-  }
-  return out;
 }
 
 /// The simulated office with a forward 180-degree laser (361 beams), poses
@@ -659,7 +642,7 @@ TEST(SensedRegions, DriftedOfficeKeepsEachRoomWhole) {
   laser.range_noise = 0.01;
   std::vector<Eigen::Isometry3d> truth;
   for (const auto& p : route) truth.push_back(pose2D(p.x, p.y, p.yaw));
-  const auto drifted = drift(truth, 7);
+  const auto drifted = sim::drift(truth, 7);
 
   ObservationGrouping<Point> g;
   for (std::size_t k = 0; k < route.size(); ++k)

@@ -141,4 +141,22 @@ double rmsPositionError(const std::vector<Eigen::Isometry3d>& a, const std::vect
   return std::sqrt(sum / double(n));
 }
 
+double adjustedRandIndex(const std::vector<int>& a, const std::vector<int>& b) {
+  std::map<std::pair<int, int>, double> table;
+  std::map<int, double> rows, cols;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    table[{a[i], b[i]}] += 1;
+    rows[a[i]] += 1;
+    cols[b[i]] += 1;
+  }
+  const auto pairs = [](double n) { return n * (n - 1) / 2; };
+  double index = 0, sum_rows = 0, sum_cols = 0;
+  for (const auto& [key, n] : table) index += pairs(n);
+  for (const auto& [key, n] : rows) sum_rows += pairs(n);
+  for (const auto& [key, n] : cols) sum_cols += pairs(n);
+  const double expected = sum_rows * sum_cols / pairs(double(a.size()));
+  const double maximum = (sum_rows + sum_cols) / 2;
+  return maximum == expected ? 0.0 : (index - expected) / (maximum - expected);
+}
+
 }  // namespace obsgroup::sim

@@ -65,6 +65,10 @@ Eigen::Isometry3d toIsometry(const Pose2D& pose, double z = 0.0);
 /// of evaluate_local_maps). The first pose is kept; deterministic for a seed.
 std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed);
 
+/// Adjusted Rand index of two labellings (Hubert and Arabie): 1 when they
+/// are the same partition, about 0 for a chance agreement.
+double adjustedRandIndex(const std::vector<int>& a, const std::vector<int>& b);
+
 /// Root mean square distance between the positions of two pose lists.
 double rmsPositionError(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b);
 
