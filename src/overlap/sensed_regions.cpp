@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
+#include <exception>
 #include <iterator>
 #include <limits>
 #include <stdexcept>

@@ -10,10 +10,11 @@
 ///  - free space: the cells the observation's beams or rays pass through,
 ///    from the sensor to each point (2D: cells of a plane grid; 3D: voxels);
 ///  - visibility: the cells visible from the observation's position, all
-///    around it, in the occupancy grid made of every observation's points
-///    (3D: the points in a horizontal band about the sensor's height). It
-///    does not depend on the heading, so a forward laser or a camera that
-///    looks the other way in the same room still overlaps.
+///    around it: where its own beams looked, what they saw; elsewhere, what
+///    the occupancy grid of every observation's points lets through (3D: the
+///    points in a horizontal band about the sensor's height). It does not
+///    depend on the heading, so a forward laser or a camera that looks the
+///    other way in the same room still overlaps.
 /// With either, Pi(i, j) = |R_i and R_j| / |R_i| and Psi is eq. (18) as before.
 
 #include "obsgroup/interrupt.h"
@@ -30,7 +31,7 @@ namespace obsgroup {
 enum class SensedSpaceModel {
   Points,     ///< End points matched within delta, eq. (16)-(17): the paper's.
   FreeSpace,  ///< Cells crossed by the beams / rays.
-  Visibility  ///< Cells visible from the pose in the shared occupancy grid.
+  Visibility  ///< Cells visible all around the pose (own beams, then the shared occupancy grid).
 };
 
 std::string toString(SensedSpaceModel model);
@@ -104,7 +105,8 @@ MatchCounts countSharedCells(const ObservationRegions& regions, int threads = 0,
                              const InterruptFlag* interrupt = nullptr);
 
 /// Pi (eq. 17 with cells for points) and Psi (eq. 18) of the regions;
-/// points_per_observation is left to the caller.
+/// points_per_observation holds each region's cells (SensedSpaceOverlap moves
+/// them to region_cells and puts the points there).
 OverlapResult regionOverlap(const ObservationRegions& regions, int threads = 0,
                             const InterruptFlag* interrupt = nullptr);
 
