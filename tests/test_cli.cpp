@@ -524,6 +524,17 @@ TEST_F(Cli, UsageErrors) {
   EXPECT_EQ(run("partition " + input + out + " --no-such-option").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --poses x.txt").code, 2);  // poses for a log
   EXPECT_EQ(run("partition " + kData + "/office_3d/pcd" + out + " --laser front").code, 2);
+  // Options of another sensed-space model are a mistake, not a no-op.
+  const Result delta = run("partition " + input + out + " --delta 0.2");  // the default model has cells
+  EXPECT_EQ(delta.code, 2);
+  EXPECT_NE(delta.err.find("--delta applies to --sso points"), std::string::npos) << delta.err;
+  EXPECT_EQ(run("partition " + input + out + " --sso points --cell 0.3").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --sso free-space --clearance 0.5").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --paper --split best").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --paper --ncut-threshold 0.8").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --band 1 0").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --sso voxels").code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
   const Result missing = run("partition " + (dir_ / "nothing.clf").string() + out);
   EXPECT_EQ(missing.code, 3);
   EXPECT_NE(missing.err.find("no such file or folder"), std::string::npos) << missing.err;
