@@ -319,13 +319,13 @@ bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, const Regio
   return height >= params.band_low && height <= params.band_high;
 }
 
-/// The plane cells occupied by at least params.min_observations observations.
-/// Sorts integers in parallel: the same order whatever the threads.
-void sortKeys(std::vector<std::uint64_t>& keys) {
+/// Sorts distinct-or-integer values in parallel: one order whatever the threads.
+template <typename T>
+void sortInParallel(std::vector<T>& values) {
 #if defined(__GLIBCXX__) && defined(_OPENMP)
-  __gnu_parallel::sort(keys.begin(), keys.end());
+  __gnu_parallel::sort(values.begin(), values.end());
 #else
-  std::sort(keys.begin(), keys.end());
+  std::sort(values.begin(), values.end());
 #endif
 }
 
@@ -339,7 +339,7 @@ std::vector<std::uint64_t> gatherSorted(std::vector<std::vector<std::uint64_t>>&
     all.insert(all.end(), keys.begin(), keys.end());
     std::vector<std::uint64_t>().swap(keys);
   }
-  sortKeys(all);
+  sortInParallel(all);
   return all;
 }
 
@@ -606,11 +606,7 @@ MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int thre
     std::vector<std::uint64_t>().swap(lists[i]);
   }
   throwIfInterrupted(interrupt);
-#if defined(__GLIBCXX__) && defined(_OPENMP)
-  __gnu_parallel::sort(entries.begin(), entries.end());  // distinct entries: one order whatever the threads
-#else
-  std::sort(entries.begin(), entries.end());
-#endif
+  sortInParallel(entries);  // distinct entries
   throwIfInterrupted(interrupt);
 
   // Cell c holds the observations watchers[cell_start[c], cell_start[c+1]);
