@@ -122,7 +122,8 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
     frames.push_back(maps[g].frame);
     if (!maps[g].filtered) warn("local map " + std::to_string(g) + ": too large for a " +
                                           std::to_string(map_voxel) + " m voxel filter; written unfiltered");
-    if (maps[g].fell_back) warn("local map " + std::to_string(g) + ": LUM diverged; kept the ICP alignment");
+    const std::string refined = maps[g].refinement.warning();
+    if (!refined.empty()) warn("local map " + std::to_string(g) + ": " + refined);
   }
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& o : observations) poses.push_back(o.pose);

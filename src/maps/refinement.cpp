@@ -1,5 +1,16 @@
-#include "obsgroup/maps/local_map_builder.h"
+#include "obsgroup/maps/refinement.h"
 
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -18,6 +29,565 @@ Refinement refinementFromString(const std::string& name) {
   if (name == "icp") return Refinement::Icp;
   if (name == "lum") return Refinement::Lum;
   throw std::invalid_argument("unknown refinement '" + name + "' (expected none, icp or lum)");
+}
+
+std::string RefinementReport::warning() const {
+  if (kept_beyond_bound == 0 && kept_unaligned == 0 && pairs_partial == 0) return "";
+  std::string text = "refined " + std::to_string(moved) + " of " + std::to_string(members) + " members";
+  if (kept_beyond_bound > 0)
+    text += "; " + std::to_string(kept_beyond_bound) + " kept their input pose (the correction exceeded its bound)";
+  if (kept_unaligned > 0)
+    text += "; " + std::to_string(kept_unaligned) + " kept their input pose (no pair aligned: " +
+            std::to_string(pairs_refused) + " of " + std::to_string(pairs) + " pairs refused)";
+  if (pairs_partial > 0)
+    text += "; " + std::to_string(pairs_partial) + " of " + std::to_string(pairs) +
+            " pairs constrain only some directions (a corridor): the others keep the input poses";
+  return text;
+}
+
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// The coordinates a refinement moves, of (x, y, z, roll, pitch, yaw)
+/// perturbations: SE(2) moves x, y and yaw only.
+struct Freedom {
+  explicit Freedom(bool planar_) : planar(planar_) {
+    if (planar) active = {0, 1, 5};
+    else active = {0, 1, 2, 3, 4, 5};
+  }
+  bool planar;
+  std::vector<int> active;
+  int size() const { return static_cast<int>(active.size()); }
+};
+
+/// exp of a perturbation (translation, rotation vector), applied on the
+/// left. In SE(2) the rotation is written out so that z, roll and pitch of
+/// the pose it moves stay bit for bit what they were.
+Eigen::Isometry3d exponential(const Vector6d& d, bool planar) {
+  Eigen::Isometry3d e = Eigen::Isometry3d::Identity();
+  if (planar) {
+    const double c = std::cos(d[5]), s = std::sin(d[5]);
+    e.linear() << c, -s, 0, s, c, 0, 0, 0, 1;
+    e.translation() << d[0], d[1], 0;
+  } else {
+    const double angle = d.tail<3>().norm();
+    if (angle > 0) e.linear() = Eigen::AngleAxisd(angle, d.tail<3>() / angle).toRotationMatrix();
+    e.translation() = d.head<3>();
+  }
+  return e;
+}
+
+/// The inverse of exponential().
+Vector6d logarithm(const Eigen::Isometry3d& pose, bool planar) {
+  Vector6d d = Vector6d::Zero();
+  d.head<3>() = pose.translation();
+  if (planar) {
+    d[2] = 0;
+    d[5] = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
+  } else {
+    const Eigen::AngleAxisd a(pose.linear());
+    d.tail<3>() = a.angle() * a.axis();
+  }
+  return d;
+}
+
+double rotationAngle(const Eigen::Isometry3d& pose) { return Eigen::AngleAxisd(pose.linear()).angle(); }
+
+/// A member thinned for alignment, with a surface normal per point (zero
+/// where the neighbourhood is no line or plane) and a search tree.
+struct PreparedMember {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  std::vector<Eigen::Vector3d> normals;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;  ///< built only when `searchable`
+  bool searchable = false;
+};
+
+std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel, bool planar) {
+  auto member = std::make_unique<PreparedMember>();
+  pcl::PointCloud<pcl::PointXYZ>::Ptr raw(new pcl::PointCloud<pcl::PointXYZ>);
+  raw->reserve(points.size());
+  for (const auto& p : points) raw->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  member->cloud.reset(new pcl::PointCloud<pcl::PointXYZ>);
+  if (voxel > 0 && !raw->empty()) {
+    pcl::VoxelGrid<pcl::PointXYZ> grid;
+    grid.setLeafSize(float(voxel), float(voxel), float(voxel));
+    grid.setInputCloud(raw);
+    grid.filter(*member->cloud);
+  } else {
+    member->cloud = raw;
+  }
+  const auto& cloud = *member->cloud;
+  member->normals.assign(cloud.size(), Eigen::Vector3d::Zero());
+  if (cloud.size() < 3) return member;
+  member->tree.setInputCloud(member->cloud);
+  member->searchable = true;
+  // A line (2D) or plane (3D) fitted to the nearest points; a corner or a
+  // scatter gives no normal, and the point then matches nothing.
+  const int k = planar ? 6 : 10;
+  const double max_spread = std::max(0.5, 8 * voxel);
+  pcl::Indices neighbours;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    member->tree.nearestKSearch(cloud[i], k, neighbours, distances);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int used = 0;
+    for (std::size_t j = 0; j < neighbours.size(); ++j)
+      if (distances[j] <= max_spread * max_spread) {
+        mean += cloud[neighbours[j]].getVector3fMap().cast<double>();
+        ++used;
+      }
+    if (used < 3) continue;
+    mean /= used;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (std::size_t j = 0; j < neighbours.size(); ++j)
+      if (distances[j] <= max_spread * max_spread) {
+        const Eigen::Vector3d d = cloud[neighbours[j]].getVector3fMap().cast<double>() - mean;
+        covariance += d * d.transpose();
+      }
+    if (planar) {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(covariance.topLeftCorner<2, 2>());
+      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1])
+        member->normals[i] << eigen.eigenvectors().col(0), 0;
+    } else {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1]) member->normals[i] = eigen.eigenvectors().col(0);
+    }
+  }
+  return member;
+}
+
+/// Point-to-surface residual of `x` (in the target's frame) against its
+/// nearest target point; false when none lies within `gate` or it has no normal.
+bool residual(const PreparedMember& target, const Eigen::Vector3d& x, double gate, double& r,
+              Eigen::Vector3d& normal) {
+  if (!target.searchable) return false;
+  pcl::Indices index(1);
+  std::vector<float> distance(1);
+  const pcl::PointXYZ query(float(x.x()), float(x.y()), float(x.z()));
+  if (target.tree.nearestKSearch(query, 1, index, distance) < 1 || distance[0] > gate * gate) return false;
+  normal = target.normals[index[0]];
+  if (normal.isZero()) return false;
+  r = normal.dot(x - target.cloud->points[index[0]].getVector3fMap().cast<double>());
+  return true;
+}
+
+/// The columns of `freedom`'s perturbations (left, about the frame's
+/// origin) that a unit step of each normalised coordinate makes: rotations
+/// about `centre` (where the matched points are, so that turning does not
+/// also shift them) and scaled by `radius` (their spread), so that every
+/// coordinate moves the points by about a metre per unit.
+Eigen::MatrixXd normaliser(const Freedom& freedom, const Eigen::Vector3d& centre, double radius) {
+  Matrix6d full = Matrix6d::Identity();
+  full.block<3, 3>(0, 3) << 0, -centre.z(), centre.y(), centre.z(), 0, -centre.x(), -centre.y(), centre.x(), 0;
+  full.block<6, 3>(0, 3) /= radius;
+  const int n = freedom.size();
+  Eigen::MatrixXd N(n, n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) N(a, b) = full(freedom.active[a], freedom.active[b]);
+  return N;
+}
+
+Eigen::MatrixXd activeBlock(const Matrix6d& H, const Freedom& freedom) {
+  const int n = freedom.size();
+  Eigen::MatrixXd h(n, n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) h(a, b) = H(freedom.active[a], freedom.active[b]);
+  return h;
+}
+
+/// The information `h` (in `freedom`'s coordinates) with the directions it
+/// barely constrains removed: in normalised coordinates (normaliser()),
+/// eigenvalues at or below `threshold` are set to 0. Each match adds at
+/// most about 1 to an eigenvalue there (unit normals), so threshold =
+/// ratio x matches asks a direction to be held by that share of the
+/// matches: a dominant floor must not make the walls look negligible.
+struct Constrained {
+  Eigen::MatrixXd information;
+  int dropped = 0;
+};
+
+Constrained constrain(const Eigen::MatrixXd& h, const Eigen::MatrixXd& N, double threshold) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(N.transpose() * h * N);
+  Eigen::VectorXd values = eigen.eigenvalues();
+  Constrained result;
+  for (int a = 0; a < values.size(); ++a)
+    if (!(values[a] > threshold)) {
+      values[a] = 0;
+      ++result.dropped;
+    }
+  const Eigen::MatrixXd inverse = N.inverse();
+  result.information = inverse.transpose() * (eigen.eigenvectors() * values.asDiagonal() *
+                                              eigen.eigenvectors().transpose()) * inverse;
+  return result;
+}
+
+/// `step` (in `freedom`'s coordinates) with its components along the
+/// directions `h` barely constrains removed, as constrain() decides them.
+Eigen::VectorXd keepConstrained(const Eigen::VectorXd& step, const Eigen::MatrixXd& h, const Eigen::MatrixXd& N,
+                                double threshold) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(N.transpose() * h * N);
+  Eigen::VectorXd u = eigen.eigenvectors().transpose() * N.inverse() * step;
+  for (int a = 0; a < u.size(); ++a)
+    if (!(eigen.eigenvalues()[a] > threshold)) u[a] = 0;
+  return N * (eigen.eigenvectors() * u);
+}
+
+/// The Gauss-Newton step of one iteration in the well-constrained
+/// directions only: the others stay where the guess put them.
+Vector6d constrainedStep(const Matrix6d& H, const Vector6d& g, const Freedom& freedom, const Eigen::MatrixXd& N,
+                         double threshold) {
+  const int n = freedom.size();
+  Eigen::VectorXd gradient(n);
+  for (int a = 0; a < n; ++a) gradient[a] = g[freedom.active[a]];
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(N.transpose() * activeBlock(H, freedom) * N);
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(n);
+  for (int a = 0; a < n; ++a)
+    if (eigen.eigenvalues()[a] > threshold) inverse[a] = 1.0 / eigen.eigenvalues()[a];
+  const Eigen::VectorXd step =
+      -(N * (eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose()) * N.transpose() * gradient);
+  Vector6d d = Vector6d::Zero();
+  for (int a = 0; a < n; ++a) d[freedom.active[a]] = step[a];
+  return d;
+}
+
+struct PairAlignment {
+  bool usable = false;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< source in the target's frame
+  Eigen::MatrixXd information;                             ///< of `pose`, left perturbations
+  bool partial = false;                                    ///< some directions were left to the guess
+  double floor = 0;   ///< information below which a direction counts as unconstrained
+  double radius = 1;  ///< of the matched points: the scale of rotations
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< of the matched points, target frame
+};
+
+/// Aligns `source` onto `target` from `guess` (the source's pose in the
+/// target's frame): robust (Cauchy) point-to-line or point-to-plane
+/// Gauss-Newton, the correspondence gate shrinking from
+/// max_correspondence_distance to 3 x inlier_distance.
+PairAlignment alignPair(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& guess,
+                        const Freedom& freedom, const RefinementParameters& parameters) {
+  PairAlignment result;
+  const auto& points = source.cloud->points;
+  if (points.size() < 6 || target.cloud->size() < 6) return result;
+  const double inlier = parameters.inlier_distance;
+  const double final_gate = 3 * inlier;
+  double gate = std::max(parameters.max_correspondence_distance, final_gate);
+  Eigen::Isometry3d pose = guess;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 1.0;
+  double weight_sum = 0;
+  const auto accumulate = [&](double g, Matrix6d& H, Vector6d& gradient, double& squares, int& inliers) {
+    weight_sum = 0;
+    H.setZero();
+    gradient.setZero();
+    squares = 0;
+    inliers = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double squared_sum = 0;
+    int used = 0;
+    for (const auto& p : points) {
+      const Eigen::Vector3d x = pose * p.getVector3fMap().cast<double>();
+      double r;
+      Eigen::Vector3d n;
+      if (!residual(target, x, g, r, n)) continue;
+      Vector6d J;
+      J << n, x.cross(n);
+      const double w = 1.0 / (1.0 + (r / inlier) * (r / inlier));  // Cauchy: far matches barely pull
+      H += w * J * J.transpose();
+      weight_sum += w;
+      gradient += w * J * r;
+      sum += x;
+      squared_sum += x.squaredNorm();
+      ++used;
+      if (std::abs(r) < inlier) {
+        squares += r * r;
+        ++inliers;
+      }
+    }
+    if (used > 0) {
+      centre = sum / used;
+      radius = std::max(0.5, std::sqrt(std::max(0.0, squared_sum / used - centre.squaredNorm())));
+    }
+    return used;
+  };
+  Matrix6d H;
+  Vector6d gradient;
+  double squares;
+  int inliers;
+  for (int iteration = 0; iteration < parameters.max_iterations; ++iteration) {
+    if (accumulate(gate, H, gradient, squares, inliers) < 6) return result;
+    const Vector6d step = constrainedStep(H, gradient, freedom, normaliser(freedom, centre, radius),
+                                          parameters.min_constraint_ratio * weight_sum);
+    pose = exponential(step, freedom.planar) * pose;
+    const bool at_final_gate = gate <= final_gate;
+    gate = std::max(final_gate, gate * 0.7);
+    if (at_final_gate && step.head<3>().norm() < 1e-5 && step.tail<3>().norm() < 1e-6) break;
+  }
+  const int used = accumulate(final_gate, H, gradient, squares, inliers);
+  if (used < 6 || !pose.matrix().allFinite()) return result;
+  const double overlap = double(inliers) / double(points.size());
+  const Eigen::Isometry3d correction = guess.inverse() * pose;
+  if (overlap < parameters.min_overlap || correction.translation().norm() > parameters.max_translation_correction ||
+      rotationAngle(correction) > parameters.max_rotation_correction)
+    return result;
+  // Noise of the matches, from the inliers; a floor keeps near-perfect
+  // simulated data from claiming an absurd certainty.
+  const double sigma2 = std::max(squares / std::max(inliers, 1), 1e-6);
+  const Constrained c = constrain(activeBlock(H, freedom) / sigma2, normaliser(freedom, centre, radius),
+                                  parameters.min_constraint_ratio * weight_sum / sigma2);
+  result.usable = true;
+  result.pose = pose;
+  result.information = c.information;
+  result.partial = c.dropped > 0;
+  result.floor = parameters.min_constraint_ratio * weight_sum / sigma2;
+  result.radius = radius;
+  result.centre = centre;
+  return result;
+}
+
+struct GraphEdge {
+  int a = 0, b = 0;                 ///< target and source member positions
+  Eigen::Isometry3d measured;       ///< pose of b in a's frame
+  Eigen::MatrixXd information;      ///< of the left perturbation of `measured`
+  double floor = 0, radius = 1;     ///< as PairAlignment's
+  Eigen::Vector3d centre;           ///< PairAlignment's, in the map frame
+};
+
+/// Residual of an edge, in `freedom`'s coordinates: log(X_a^-1 X_b Z^-1).
+Eigen::VectorXd edgeResidual(const Eigen::Isometry3d& Xa, const Eigen::Isometry3d& Xb, const Eigen::Isometry3d& Z,
+                             const Freedom& freedom) {
+  const Vector6d e = logarithm(Xa.inverse() * Xb * Z.inverse(), freedom.planar);
+  Eigen::VectorXd r(freedom.size());
+  for (int a = 0; a < freedom.size(); ++a) r[a] = e[freedom.active[a]];
+  return r;
+}
+
+/// Lu & Milios: the member poses that best agree with every pairwise
+/// alignment, each weighted by its information, and a weak prior keeping
+/// every member near its input pose in the directions no pair constrains.
+/// Gauss-Newton on left perturbations, the reference fixed.
+std::vector<Eigen::Isometry3d> solvePoseGraph(const std::vector<Eigen::Isometry3d>& input, int reference,
+                                              const std::vector<GraphEdge>& edges, const Freedom& freedom,
+                                              const RefinementParameters& parameters) {
+  const int m = static_cast<int>(input.size());
+  const int n = freedom.size();
+  std::vector<int> column(m, -1);
+  int variables = 0;
+  for (int k = 0; k < m; ++k)
+    if (k != reference) column[k] = n * variables++;
+  Eigen::MatrixXd prior = Eigen::MatrixXd::Zero(n, n);
+  for (int a = 0; a < n; ++a) {
+    const double sigma =
+        freedom.active[a] < 3 ? parameters.max_translation_correction : parameters.max_rotation_correction;
+    prior(a, a) = 1.0 / (sigma * sigma);
+  }
+  // Per member: the sum of its pairs' floors (see PairAlignment) and their mean radius.
+  // The directions a member's pairs pin down are judged about where their
+  // matched points lie, as each pair judged its own.
+  std::vector<double> floor(m, 0.0), radius(m, 0.0);
+  std::vector<Eigen::Vector3d> centre(m, Eigen::Vector3d::Zero());
+  std::vector<int> incident(m, 0);
+  for (const GraphEdge& e : edges)
+    for (int k : {e.a, e.b}) {
+      floor[k] += e.floor;
+      radius[k] += e.radius;
+      centre[k] += e.centre;
+      ++incident[k];
+    }
+  for (int k = 0; k < m; ++k) {
+    radius[k] = incident[k] > 0 ? radius[k] / incident[k] : 1.0;
+    if (incident[k] > 0) centre[k] /= incident[k];
+  }
+  std::vector<Eigen::Isometry3d> X = input;
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  constexpr double kStep = 1e-6;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    Eigen::VectorXd gradient = Eigen::VectorXd::Zero(n * variables);
+    std::vector<Eigen::MatrixXd> own(m, Eigen::MatrixXd::Zero(n, n));  // each member's block from the pairs alone
+    const auto add = [&](int ka, int kb, const Eigen::MatrixXd& Ja, const Eigen::MatrixXd& Jb,
+                         const Eigen::VectorXd& r, const Eigen::MatrixXd& omega, bool pair) {
+      const int ks[2] = {ka, kb};
+      const Eigen::MatrixXd* Js[2] = {&Ja, &Jb};
+      for (int s = 0; s < 2; ++s) {
+        if (ks[s] < 0 || column[ks[s]] < 0) continue;
+        if (pair) own[ks[s]] += Js[s]->transpose() * omega * *Js[s];
+        gradient.segment(column[ks[s]], n) += Js[s]->transpose() * omega * r;
+        for (int t = 0; t < 2; ++t) {
+          if (ks[t] < 0 || column[ks[t]] < 0) continue;
+          const Eigen::MatrixXd block = Js[s]->transpose() * omega * *Js[t];
+          for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) triplets.emplace_back(column[ks[s]] + i, column[ks[t]] + j, block(i, j));
+        }
+      }
+    };
+    // Numerical Jacobians: a few small matrix products per edge, and no
+    // hand-derived SE(3) adjoints to get wrong.
+    const auto jacobian = [&](const auto& residualOf, const Eigen::Isometry3d& X0, const Eigen::VectorXd& r0) {
+      Eigen::MatrixXd J(n, n);
+      for (int a = 0; a < n; ++a) {
+        Vector6d d = Vector6d::Zero();
+        d[freedom.active[a]] = kStep;
+        J.col(a) = (residualOf(exponential(d, freedom.planar) * X0) - r0) / kStep;
+      }
+      return J;
+    };
+    for (const GraphEdge& e : edges) {
+      const Eigen::VectorXd r = edgeResidual(X[e.a], X[e.b], e.measured, freedom);
+      const Eigen::MatrixXd Ja =
+          jacobian([&](const Eigen::Isometry3d& Y) { return edgeResidual(Y, X[e.b], e.measured, freedom); }, X[e.a], r);
+      const Eigen::MatrixXd Jb =
+          jacobian([&](const Eigen::Isometry3d& Y) { return edgeResidual(X[e.a], Y, e.measured, freedom); }, X[e.b], r);
+      add(e.a, e.b, Ja, Jb, r, e.information, true);
+    }
+    for (int k = 0; k < m; ++k) {
+      if (column[k] < 0) continue;
+      const Eigen::VectorXd r = edgeResidual(identity, X[k], input[k], freedom);
+      const Eigen::MatrixXd J =
+          jacobian([&](const Eigen::Isometry3d& Y) { return edgeResidual(identity, Y, input[k], freedom); }, X[k], r);
+      add(k, -1, J, J, r, prior, false);
+    }
+    Eigen::SparseMatrix<double> H(n * variables, n * variables);
+    H.setFromTriplets(triplets.begin(), triplets.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
+    if (solver.info() != Eigen::Success) break;
+    const Eigen::VectorXd step = solver.solve(-gradient);
+    if (solver.info() != Eigen::Success || !step.allFinite()) break;
+    for (int k = 0; k < m; ++k) {
+      if (column[k] < 0) continue;
+      // Solution remapping (Zhang et al., ICRA 2016): a member moves only
+      // in the directions its own pairs pin down. Many pairs that each
+      // leave a corridor's axis free would otherwise pin it together
+      // through the noise in their normals.
+      const Eigen::VectorXd local = keepConstrained(step.segment(column[k], n), own[k],
+                                                    normaliser(freedom, centre[k], radius[k]), floor[k]);
+      Vector6d d = Vector6d::Zero();
+      for (int a = 0; a < n; ++a) d[freedom.active[a]] = local[a];
+      X[k] = exponential(d, freedom.planar) * X[k];
+    }
+    if (step.lpNorm<Eigen::Infinity>() < 1e-9) break;
+  }
+  return X;
+}
+
+/// Soft share of member k's points that lie on a neighbour's surface at the
+/// poses X: each point counts 1 - (r / inlier_distance)^2 for its best
+/// neighbour (0 beyond). Higher is a more consistent map around k.
+double consistency(int k, const std::vector<int>& neighbours, const std::vector<std::unique_ptr<PreparedMember>>& members,
+                   const std::vector<Eigen::Isometry3d>& X, const RefinementParameters& parameters) {
+  const auto& points = members[k]->cloud->points;
+  if (points.empty() || neighbours.empty()) return 0;
+  const double inlier = parameters.inlier_distance;
+  std::vector<Eigen::Isometry3d> into;  // k's frame into each neighbour's
+  for (int j : neighbours) into.push_back(X[j].inverse() * X[k]);
+  double sum = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector3d local = p.getVector3fMap().cast<double>();
+    double best = 0;
+    for (std::size_t s = 0; s < neighbours.size(); ++s) {
+      double r;
+      Eigen::Vector3d n;
+      if (residual(*members[neighbours[s]], into[s] * local, 3 * inlier, r, n))
+        best = std::max(best, 1.0 - (r / inlier) * (r / inlier));
+    }
+    sum += best;
+  }
+  return sum / double(points.size());
+}
+
+bool posesArePlanar(const std::vector<Eigen::Isometry3d>& poses) {
+  for (const auto& pose : poses) {
+    const Eigen::Matrix3d& R = pose.linear();
+    if (std::abs(R(2, 2) - 1) > 1e-9 || std::abs(R(0, 2)) > 1e-9 || std::abs(R(1, 2)) > 1e-9 ||
+        std::abs(pose.translation().z()) > 1e-9)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
+                                   const std::vector<std::pair<int, int>>& pairs, bool planar,
+                                   const RefinementParameters& parameters, LocalMapFrame& frame) {
+  RefinementReport report;
+  const int m = static_cast<int>(frame.members.size());
+  if (static_cast<int>(points.size()) != m || static_cast<int>(frame.member_poses.size()) != m)
+    throw std::invalid_argument("refineMemberPoses: one point list and one pose per member expected");
+  const int reference = static_cast<int>(std::lower_bound(frame.members.begin(), frame.members.end(), frame.reference) -
+                                         frame.members.begin());
+  report.members = m - 1;
+  if (refinement == Refinement::None || m < 2) return report;
+  const Freedom freedom(planar && posesArePlanar(frame.member_poses));
+
+  std::vector<std::unique_ptr<PreparedMember>> members;
+  members.reserve(m);
+  for (const auto& p : points) members.push_back(prepare(p, parameters.alignment_voxel, freedom.planar));
+
+  const std::vector<Eigen::Isometry3d> input = frame.member_poses;
+  std::vector<GraphEdge> edges;
+  std::vector<std::vector<int>> neighbours(m);
+  std::vector<bool> aligned(m, false);
+  aligned[reference] = true;
+  for (const auto& [a, b] : pairs) {
+    ++report.pairs;
+    neighbours[a].push_back(b);
+    neighbours[b].push_back(a);
+    const PairAlignment pair =
+        alignPair(*members[b], *members[a], input[a].inverse() * input[b], freedom, parameters);
+    if (!pair.usable) {
+      ++report.pairs_refused;
+      continue;
+    }
+    if (pair.partial) ++report.pairs_partial;
+    aligned[a] = aligned[b] = true;
+    edges.push_back({a, b, pair.pose, pair.information, pair.floor, pair.radius, input[a] * pair.centre});
+  }
+  std::vector<Eigen::Isometry3d> refined = solvePoseGraph(input, reference, edges, freedom, parameters);
+
+  // A member keeps its refined pose only if the correction is within its
+  // bounds and the refined map puts more of its points on its neighbours'
+  // surfaces; a second pass rechecks the rest once the first reverts are in.
+  enum class Outcome { Moved, NotBetter, BeyondBound, Unaligned };
+  std::vector<Outcome> outcome(m, Outcome::Moved);
+  for (int k = 0; k < m; ++k) {
+    if (k == reference) continue;
+    const Eigen::Isometry3d correction = input[k].inverse() * refined[k];
+    if (!aligned[k]) outcome[k] = Outcome::Unaligned;
+    else if (!refined[k].matrix().allFinite() ||
+             correction.translation().norm() > parameters.max_translation_correction ||
+             rotationAngle(correction) > parameters.max_rotation_correction)
+      outcome[k] = Outcome::BeyondBound;
+    if (outcome[k] != Outcome::Moved) refined[k] = input[k];
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> revert;
+    for (int k = 0; k < m; ++k) {
+      if (k == reference || outcome[k] != Outcome::Moved) continue;
+      const double before = consistency(k, neighbours[k], members, input, parameters);
+      const double after = consistency(k, neighbours[k], members, refined, parameters);
+      if (!(after > before * (1 + parameters.min_gain))) revert.push_back(k);
+    }
+    for (int k : revert) {
+      outcome[k] = Outcome::NotBetter;
+      refined[k] = input[k];
+    }
+    if (revert.empty()) break;
+  }
+  for (int k = 0; k < m; ++k) {
+    if (k == reference) continue;
+    switch (outcome[k]) {
+      case Outcome::Moved: ++report.moved; break;
+      case Outcome::NotBetter: ++report.kept_not_better; break;
+      case Outcome::BeyondBound: ++report.kept_beyond_bound; break;
+      case Outcome::Unaligned: ++report.kept_unaligned; break;
+    }
+  }
+  refined[reference] = Eigen::Isometry3d::Identity();
+  frame.member_poses = refined;
+  return report;
 }
 
 }  // namespace obsgroup

@@ -2,20 +2,21 @@
 
 #include "obsgroup/maps/local_map_builder.h"
 
+#include "obsgroup/common/parallel_for.h"
+
 #include <pcl/common/common.h>
 #include <pcl/common/transforms.h>
+#include <pcl/filters/filter.h>
 #include <pcl/filters/voxel_grid.h>
-#include <pcl/registration/correspondence_estimation.h>
-#include <pcl/registration/icp.h>
-#include <pcl/registration/lum.h>
-#include <pcl/registration/transformation_estimation_2D.h>
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <queue>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -25,16 +26,11 @@ namespace detail {
 /// The finite points of a cloud, moved by `pose` (composed in double).
 template <typename PointT>
 typename pcl::PointCloud<PointT>::Ptr movedCloud(const pcl::PointCloud<PointT>& in, const Eigen::Isometry3d& pose) {
+  pcl::PointCloud<PointT> finite;
+  pcl::Indices kept;
+  pcl::removeNaNFromPointCloud(in, finite, kept);
   typename pcl::PointCloud<PointT>::Ptr out(new pcl::PointCloud<PointT>);
-  out->reserve(in.size());
-  for (PointT p : in.points) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
-    const Eigen::Vector3f q = (pose * Eigen::Vector3d(p.x, p.y, p.z)).template cast<float>();
-    p.x = q.x();
-    p.y = q.y();
-    p.z = q.z();
-    out->push_back(p);
-  }
+  pcl::transformPointCloud(finite, *out, Eigen::Affine3d(pose.matrix()));
   return out;
 }
 
@@ -94,109 +90,45 @@ std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& o
   return poses;
 }
 
-inline Eigen::Vector6f toPose6(const Eigen::Isometry3d& pose) {
-  Eigen::Vector6f v;
-  const Eigen::Affine3f a(pose.matrix().cast<float>());
-  pcl::getTranslationAndEulerAngles(a, v[0], v[1], v[2], v[3], v[4], v[5]);
-  return v;
-}
-
-inline Eigen::Isometry3d fromAffine(const Eigen::Affine3f& a) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  const Eigen::Matrix3d R = a.linear().cast<double>();
-  pose.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();  // re-orthonormalised after float
-  pose.translation() = a.translation().cast<double>();
-  return pose;
-}
-
 }  // namespace detail
 
 template <typename PointT>
-void LocalMapBuilder<PointT>::refineIcp(const std::vector<Observation<PointT>>& observations, const WeightMatrix& W,
-                                        LocalMapFrame& frame) const {
-  pcl::IterativeClosestPoint<PointT, PointT> icp;
-  icp.setMaxCorrespondenceDistance(max_correspondence_distance_);
-  icp.setMaximumIterations(max_iterations_);
-  icp.setTransformationEpsilon(1e-10);
-  icp.setEuclideanFitnessEpsilon(1e-12);
-  if (detail::planar(observations, frame.members))
-    icp.setTransformationEstimation(
-        typename pcl::registration::TransformationEstimation2D<PointT, PointT>::Ptr(
-            new pcl::registration::TransformationEstimation2D<PointT, PointT>));
-  pcl::PointCloud<PointT> aligned;
-  for (const auto& [child, parent] : detail::maximumSpanningTree(frame, W)) {
-    if (parent < 0) continue;  // the reference, or a member W does not reach: input pose kept
-    const int c = frame.members[child], p = frame.members[parent];
-    // The input relative pose, hung on the parent's refined pose.
-    const Eigen::Isometry3d guess =
-        frame.member_poses[parent] * (observations[p].pose.inverse() * observations[c].pose);
-    frame.member_poses[child] = guess;
-    const auto target = detail::movedCloud(*observations[p].cloud, frame.member_poses[parent]);
-    const auto source = detail::movedCloud(*observations[c].cloud, Eigen::Isometry3d::Identity());
-    if (target->size() < 3 || source->size() < 3) continue;
-    icp.setInputTarget(target);
-    icp.setInputSource(source);
-    icp.align(aligned, guess.matrix().cast<float>());
-    if (icp.hasConverged()) frame.member_poses[child] = detail::fromAffine(Eigen::Affine3f(icp.getFinalTransformation()));
-  }
-}
-
-template <typename PointT>
-bool LocalMapBuilder<PointT>::refineLum(const std::vector<Observation<PointT>>& observations, const WeightMatrix& W,
-                                        LocalMapFrame& frame) const {
+void LocalMapBuilder<PointT>::refine(const std::vector<Observation<PointT>>& observations, const WeightMatrix& W,
+                                     LocalMap<PointT>& map) const {
+  LocalMapFrame& frame = map.frame;
   const auto& members = frame.members;
-  const std::size_t m = members.size();
-  if (m < 2) return true;
-  // LUM keeps its first vertex fixed: the reference goes first.
-  std::vector<std::size_t> order{static_cast<std::size_t>(
-      std::lower_bound(members.begin(), members.end(), frame.reference) - members.begin())};
-  for (std::size_t k = 0; k < m; ++k)
-    if (k != order[0]) order.push_back(k);
-  pcl::registration::LUM<PointT> lum;
-  std::vector<int> vertex(m);
-  for (std::size_t v = 0; v < m; ++v) {
-    const std::size_t k = order[v];
-    const auto cloud = detail::movedCloud(*observations[members[k]].cloud, Eigen::Isometry3d::Identity());
-    vertex[k] = static_cast<int>(lum.addPointCloud(cloud, v == 0 ? Eigen::Vector6f::Zero().eval()
-                                                                 : detail::toPose6(frame.member_poses[k])));
-  }
-  // Edges: the pairs of the group that overlap (W > 0).
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  for (std::size_t a = 0; a < m; ++a)
-    for (WeightMatrix::InnerIterator it(W, members[a]); it; ++it) {
-      const auto b = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
-      if (b != members.end() && *b == it.row() && static_cast<std::size_t>(b - members.begin()) > a && it.value() > 0)
-        pairs.emplace_back(a, b - members.begin());
+  std::vector<MemberPoints> points(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k)
+    for (const PointT& p : observations[members[k]].cloud->points)
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) points[k].emplace_back(p.x, p.y, p.z);
+  // The spanning tree's pairs first (each member with the one it overlaps
+  // most on the way from the reference); Lum adds every member's strongest
+  // other overlaps, so that a pose graph with loops spreads the error.
+  std::vector<std::pair<int, int>> pairs;
+  std::set<std::pair<int, int>> taken;
+  for (const auto& [child, parent] : detail::maximumSpanningTree(frame, W))
+    if (parent >= 0) {
+      pairs.emplace_back(parent, child);
+      taken.emplace(std::min(parent, child), std::max(parent, child));
     }
-  if (pairs.empty()) return true;
-  // Correspondences are re-estimated a few times only: run longer on
-  // nearest-neighbour correspondences, PCL's LUM was seen to drift away by
-  // metres on scans of a room that were perfectly aligned to begin with.
-  constexpr int kRounds = 3;
-  lum.setMaxIterations(std::max(1, max_iterations_ / kRounds));
-  for (int round = 0; round < kRounds; ++round) {
-    for (const auto& [a, b] : pairs) {
-      pcl::registration::CorrespondenceEstimation<PointT, PointT> estimation;
-      estimation.setInputSource(lum.getTransformedCloud(vertex[b]));
-      estimation.setInputTarget(lum.getTransformedCloud(vertex[a]));
-      pcl::CorrespondencesPtr correspondences(new pcl::Correspondences);
-      estimation.determineReciprocalCorrespondences(*correspondences, max_correspondence_distance_);
-      if (correspondences->size() > 3) lum.setCorrespondences(vertex[b], vertex[a], correspondences);
+  if (refinement_ == Refinement::Lum) {
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      std::vector<std::pair<double, int>> overlapping;  // (-W, member position): strongest first, ties by position
+      for (WeightMatrix::InnerIterator it(W, members[k]); it; ++it) {
+        const auto found = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
+        if (found != members.end() && *found == it.row() && it.value() > 0 && *found != members[k])
+          overlapping.emplace_back(-it.value(), static_cast<int>(found - members.begin()));
+      }
+      std::sort(overlapping.begin(), overlapping.end());
+      const std::size_t count = std::min<std::size_t>(overlapping.size(), std::max(0, parameters_.neighbours));
+      for (std::size_t s = 0; s < count; ++s) {
+        const int a = static_cast<int>(k), b = overlapping[s].second;
+        const std::pair<int, int> pair(std::min(a, b), std::max(a, b));
+        if (taken.insert(pair).second) pairs.push_back(pair);
+      }
     }
-    lum.compute();
   }
-  // Accept the result only if no pose moved further than alignment can tell.
-  std::vector<Eigen::Isometry3d> refined(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    refined[k] = members[k] == frame.reference ? Eigen::Isometry3d::Identity()
-                                               : detail::fromAffine(lum.getTransformation(vertex[k]));
-    const Eigen::Isometry3d change = frame.member_poses[k].inverse() * refined[k];
-    if (!refined[k].matrix().allFinite() || change.translation().norm() > 2 * max_correspondence_distance_ ||
-        Eigen::AngleAxisd(change.linear()).angle() > 0.2)
-      return false;
-  }
-  frame.member_poses = refined;
-  return true;
+  map.refinement = refineMemberPoses(refinement_, points, pairs, detail::planar(observations, members), parameters_, frame);
 }
 
 template <typename PointT>
@@ -212,11 +144,8 @@ LocalMap<PointT> LocalMapBuilder<PointT>::buildGroup(const std::vector<Observati
   if (group.empty()) throw std::invalid_argument("LocalMapBuilder: empty group");
   LocalMap<PointT> map;
   map.frame = initialFrame(group, W, poses);
-  // LUM starts from the ICP tree: PCL's LUM diverged from the raw input poses
-  // on drifted groups (nearest-neighbour correspondences several centimetres
-  // off); from aligned poses it spreads the residual over every overlapping pair.
-  if (refinement_ != Refinement::None) refineIcp(observations, W, map.frame);
-  if (refinement_ == Refinement::Lum) map.fell_back = !refineLum(observations, W, map.frame);
+  map.refinement.members = static_cast<int>(group.size()) - 1;
+  if (refinement_ != Refinement::None) refine(observations, W, map);
 
   map.cloud.reset(new PointCloud);
   for (std::size_t k = 0; k < group.size(); ++k)
@@ -248,9 +177,19 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
   std::vector<LocalMap<PointT>> maps(partition.groups.size());
   const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (std::size_t g = 0; g < partition.groups.size(); ++g)
-    if (!interruptRequested(interrupt_)) maps[g] = buildGroup(observations, partition.groups[g], W, poses);
+  parallelFor(partition.groups.size(), threads, [&](std::size_t g) {
+    if (interruptRequested(interrupt_)) return;
+    const std::string name = "local map " + std::to_string(g) + ": ";
+    try {
+      maps[g] = buildGroup(observations, partition.groups[g], W, poses);
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(name + e.what());
+    } catch (const std::exception& e) {
+      throw std::runtime_error(name + e.what());
+    }
+  });
   throwIfInterrupted(interrupt_);
   return maps;
 }

@@ -1,0 +1,200 @@
+// The evidence behind docs/refinement.md: does refining a local map make it
+// right, and never worse? Simulated buildings give the true poses. Each
+// dataset is grouped by obsgroup's defaults and every group built as a
+// local map three ways (Refinement::None, Icp, Lum):
+//   exact poses    how far refinement moves members that were already right
+//                  (their pose in the map frame against the input);
+//   drifted poses  the members' relative-pose error in their map frame
+//                  against the truth, before and after refinement.
+//
+//   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
+// prints the tables, or writes them into FILE between the lines
+// "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
+
+#include "floor_plan.h"
+#include "scenarios.h"
+#include "to_cloud.h"
+
+#include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/observation_grouping.h>
+
+#include <pcl/console/print.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+using namespace obsgroup;
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::uint64_t kDriftSeed = 7;
+
+struct Dataset {
+  std::string title;
+  std::vector<Cloud::ConstPtr> clouds;
+  std::vector<Eigen::Isometry3d> truth, drifted;
+};
+
+Dataset makeDataset(const std::string& key, sim::Sensor sensor) {
+  const sim::Building building = sim::makeBuilding(key);
+  Dataset d;
+  d.title = building.title + ", " + sim::describe(sensor);
+  const double height = sensor == sim::Sensor::Depth ? sim::depthCamera().height_above_floor : 0.0;
+  for (std::size_t k = 0; k < building.route.size(); ++k) {
+    const sim::Pose2D& pose = building.route[k];
+    switch (sensor) {
+      case sim::Sensor::Laser360: d.clouds.push_back(sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser360(), k)); break;
+      case sim::Sensor::Laser180: d.clouds.push_back(sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser180(), k)); break;
+      case sim::Sensor::Depth: d.clouds.push_back(sim::depthCloud<pcl::PointXYZ>(building.plan, pose, sim::depthCamera(), k)); break;
+    }
+    d.truth.push_back(sim::toIsometry(pose, height));
+  }
+  d.drifted = sim::drift(d.truth, kDriftSeed);
+  return d;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size() - 1) + 0.5))];
+}
+
+/// Translation (m) and rotation (rad) of a pose error.
+std::pair<double, double> size(const Eigen::Isometry3d& error) {
+  return {error.translation().norm(), Eigen::AngleAxisd(error.linear()).angle()};
+}
+
+struct Errors {
+  std::vector<double> translation, rotation;
+  int moved = 0, members = 0, warnings = 0, off_plane = 0;
+  double seconds = 0;
+};
+
+/// Every non-reference member's pose in its map frame against `expected`
+/// (the input pose for exact data, the truth for drifted data).
+Errors measure(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const std::vector<Eigen::Isometry3d>& expected,
+               const std::vector<Eigen::Isometry3d>& input, bool planar) {
+  Errors e;
+  for (const auto& map : maps) {
+    const LocalMapFrame& f = map.frame;
+    e.moved += map.refinement.moved;
+    e.warnings += !map.refinement.warning().empty();
+    for (std::size_t k = 0; k < f.members.size(); ++k) {
+      const int i = f.members[k];
+      if (i == f.reference) continue;
+      ++e.members;
+      const Eigen::Isometry3d want = expected[f.reference].inverse() * expected[i];
+      const auto [t, r] = size(want.inverse() * f.member_poses[k]);
+      e.translation.push_back(t);
+      e.rotation.push_back(r);
+      if (planar) {
+        const Eigen::Isometry3d in_map = input[f.reference].inverse() * input[i];
+        const Eigen::Isometry3d& m = f.member_poses[k];
+        if (m.translation().z() != in_map.translation().z() || m.linear()(2, 2) != in_map.linear()(2, 2) ||
+            m.linear()(0, 2) != in_map.linear()(0, 2) || m.linear()(1, 2) != in_map.linear()(1, 2))
+          ++e.off_plane;
+      }
+    }
+  }
+  return e;
+}
+
+std::string cell(const Errors& e) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "%.2f / %.2f | %.2f / %.2f", 100 * percentile(e.translation, 0.5),
+                100 * percentile(e.translation, 0.9), percentile(e.rotation, 0.5) * 180 / kPi,
+                percentile(e.rotation, 0.9) * 180 / kPi);
+  return buffer;
+}
+
+std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted) {
+  const Dataset d = makeDataset(key, sensor);
+  const std::vector<Eigen::Isometry3d>& input = drifted ? d.drifted : d.truth;
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  for (std::size_t k = 0; k < d.clouds.size(); ++k) observations.push_back({d.clouds[k], input[k]});
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  const Partition partition = grouping.compute();
+  const bool planar = sensor != sim::Sensor::Depth;
+  std::ostringstream out;
+  for (Refinement refinement : {Refinement::None, Refinement::Icp, Refinement::Lum}) {
+    LocalMapBuilder<pcl::PointXYZ> builder;
+    builder.setRefinement(refinement);
+    const auto start = std::chrono::steady_clock::now();
+    const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const Errors e = measure(maps, drifted ? d.truth : input, input, planar);
+    char tail[200];
+    std::snprintf(tail, sizeof tail, " | %d of %d | %d | %s | %.1f |", e.moved, e.members, e.warnings,
+                  planar ? (e.off_plane == 0 ? "yes" : "**no**") : "–", seconds);
+    out << "| " << d.title << " | " << partition.groups.size() << " | " << toString(refinement) << " | " << cell(e)
+        << tail << "\n";
+    std::cerr << d.title << (drifted ? " (drifted)" : " (exact)") << " " << toString(refinement) << ": " << cell(e)
+              << tail << "\n";
+  }
+  return out.str();
+}
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+const char* kHeader =
+    "| dataset | maps | refinement | error median / p90 (cm) | rotation median / p90 (deg) | members moved | maps "
+    "with a warning | z, roll, pitch unchanged | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  std::string output;
+  std::vector<std::string> buildings{"office", "loop"};
+  std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
+  for (int a = 1; a + 1 < argc; a += 2) {
+    const std::string option = argv[a];
+    if (option == "--output") output = argv[a + 1];
+    else if (option == "--buildings") buildings = split(argv[a + 1]);
+    else if (option == "--sensors") {
+      sensors.clear();
+      for (const auto& s : split(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
+    } else {
+      std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...]\n";
+      return 2;
+    }
+  }
+  std::ostringstream page;
+  for (bool drifted : {false, true}) {
+    page << (drifted ? "### Drifted input poses: members' error in their map frame against the truth\n\n"
+                     : "### Exact input poses: how far refinement moves each member in its map frame\n\n")
+         << kHeader;
+    for (const auto& key : buildings)
+      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted);
+    page << "\n";
+  }
+  if (output.empty()) {
+    std::cout << page.str();
+    return 0;
+  }
+  std::ifstream in(output);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string all = text.str(), begin = "<!-- generated:begin -->", end = "<!-- generated:end -->";
+  const auto b = all.find(begin), e = all.find(end);
+  if (b == std::string::npos || e == std::string::npos || e < b) {
+    std::cerr << output << ": no generated:begin/end markers\n";
+    return 1;
+  }
+  std::ofstream(output) << all.substr(0, b + begin.size()) << "\n" << page.str() << all.substr(e);
+  return 0;
+}

@@ -1,0 +1,88 @@
+#pragma once
+/// \file
+/// Refinement of a local map's member poses (paper sec. IV-A, step 3):
+/// pairwise point-to-line (2D) or point-to-plane (3D) alignment of the
+/// members that overlap, combined in a Lu & Milios pose graph, and a change
+/// kept only where it makes the map demonstrably more consistent. Planar
+/// data is refined in SE(2). Not templated: members come as plain points.
+
+#include "obsgroup/maps/topological_map.h"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace obsgroup {
+
+/// How the members' relative poses are refined.
+enum class Refinement {
+  None,  ///< Keep the input poses.
+  /// Pairwise alignment along the group's maximum spanning tree of W, from the reference outwards.
+  Icp,
+  /// Pairwise alignment of every member with its most overlapping members, all pairs
+  /// combined in one pose graph (Lu & Milios' globally consistent alignment).
+  Lum
+};
+
+std::string toString(Refinement refinement);
+/// Parses "none", "icp" or "lum"; throws std::invalid_argument otherwise.
+Refinement refinementFromString(const std::string& name);
+
+struct RefinementParameters {
+  /// Voxel leaf the members are thinned to before alignment, metres.
+  double alignment_voxel = 0.05;
+  /// Correspondence gate of the first alignment iteration, metres; it
+  /// shrinks towards 3 x inlier_distance. Bounds the pose error that can be corrected.
+  double max_correspondence_distance = 0.5;
+  /// A point lies on its neighbour's surface when nearer than this, metres:
+  /// about three times the range noise.
+  double inlier_distance = 0.05;
+  int max_iterations = 30;  ///< Per pairwise alignment.
+  /// A member moves at most this far from its input pose (in the map frame)...
+  double max_translation_correction = 0.5;
+  /// ...and turns at most this much, radians (10 degrees): larger corrections are refused.
+  double max_rotation_correction = 0.17453292519943295;
+  /// A pair is used only if this share of the source's points lands on the target's surface.
+  double min_overlap = 0.3;
+  /// A member's new pose is kept only if it puts this much larger a share of
+  /// its points on its neighbours' surfaces (soft inliers, see docs/method.md).
+  double min_gain = 0.02;
+  /// A direction of a pairwise alignment held by less than this share of the
+  /// matches (sum of squared normal components) is left to the input pose: a
+  /// corridor seen without its ends does not say where along it the robot was.
+  double min_constraint_ratio = 0.02;
+  /// Lum: each member is aligned with up to this many of its most overlapping members.
+  int neighbours = 5;
+};
+
+/// What refinement did to one local map.
+struct RefinementReport {
+  int members = 0;            ///< Members other than the reference.
+  int moved = 0;              ///< Members whose refined pose was kept.
+  int kept_not_better = 0;    ///< Input pose kept: the alignment did not make the map more consistent.
+  int kept_beyond_bound = 0;  ///< Input pose kept: the correction exceeded the bounds.
+  int kept_unaligned = 0;     ///< Input pose kept: no pair of this member aligned.
+  int pairs = 0;              ///< Pairwise alignments tried.
+  int pairs_refused = 0;      ///< Pairs that did not converge or overlap enough.
+  int pairs_partial = 0;      ///< Pairs constraining only some directions (a corridor): the rest kept.
+
+  /// One line for the run's warnings, or "" when nothing deserves one
+  /// (members kept because their input pose was already as good are normal).
+  std::string warning() const;
+};
+
+/// The finite points of one member in its own sensor frame.
+using MemberPoints = std::vector<Eigen::Vector3f>;
+
+/// Refines `frame.member_poses` (the reference stays the identity).
+/// `points[k]` belongs to `frame.members[k]`; `pairs` are the (target,
+/// source) member positions to align, spanning tree pairs first. `planar`
+/// data (every point and pose in one horizontal plane) is refined in SE(2):
+/// z, roll and pitch are left exactly as they were.
+RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
+                                   const std::vector<std::pair<int, int>>& pairs, bool planar,
+                                   const RefinementParameters& parameters, LocalMapFrame& frame);
+
+}  // namespace obsgroup
