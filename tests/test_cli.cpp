@@ -647,9 +647,11 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
       saw_completed = true;
       const auto partition = nlohmann::json::parse(now.at("partition.json"));
       EXPECT_EQ(partition.at("parameters").at("delta"), 0.2);
-      std::size_t maps = 0;
-      for (const auto& [name, content] : now) maps += name.rfind("local_maps/group_", 0) == 0;
+      std::size_t maps = 0, pictures = 0;
+      for (const auto& [name, content] : now)
+        if (name.rfind("local_maps/group_", 0) == 0) (fs::path(name).extension() == ".png" ? pictures : maps) += 1;
       EXPECT_EQ(maps, partition.at("groups").size());
+      EXPECT_EQ(pictures, partition.at("groups").size());
     }
     // Nothing but the results and the test's own files beside them.
     for (const auto& entry : fs::directory_iterator(dir_))
