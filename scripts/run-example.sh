@@ -9,5 +9,5 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build build -j"$(nproc)" --target obsgroup_cli
 ./build/obsgroup partition data/office_2d/office.clf -o out/office_2d --force
 echo
-echo "Pictures: out/office_2d/map.png (map.svg), weights.png, fiedler.png"
+echo "Pictures: out/office_2d/map.png (map.svg), weights.png, fiedler.png, local_maps/group_NNN.png"
 echo "Groups:   out/office_2d/partition.json; local maps: out/office_2d/local_maps/; topology.json/.dot"

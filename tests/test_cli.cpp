@@ -117,6 +117,11 @@ void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
     EXPECT_EQ(pcl::io::loadPCDFile((out / "local_maps" / name).string(), map), 0) << name;
   }
   EXPECT_FALSE(fs::exists(out / "local_maps" / ("group_" + std::to_string(1000 + groups) + ".pcd")));
+  for (std::size_t g = 0; g < groups; ++g) {
+    char name[32];
+    std::snprintf(name, sizeof name, "group_%03zu.png", g);
+    expectValidPng(out / "local_maps" / name);
+  }
   const nlohmann::json topology = readJson(out / "topology.json");
   EXPECT_EQ(topology.at("nodes").size(), groups);
   for (const auto& arc : topology.at("arcs")) {
@@ -642,9 +647,11 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
       saw_completed = true;
       const auto partition = nlohmann::json::parse(now.at("partition.json"));
       EXPECT_EQ(partition.at("parameters").at("delta"), 0.2);
-      std::size_t maps = 0;
-      for (const auto& [name, content] : now) maps += name.rfind("local_maps/group_", 0) == 0;
+      std::size_t maps = 0, pictures = 0;
+      for (const auto& [name, content] : now)
+        if (name.rfind("local_maps/group_", 0) == 0) (fs::path(name).extension() == ".png" ? pictures : maps) += 1;
       EXPECT_EQ(maps, partition.at("groups").size());
+      EXPECT_EQ(pictures, partition.at("groups").size());
     }
     // Nothing but the results and the test's own files beside them.
     for (const auto& entry : fs::directory_iterator(dir_))
@@ -726,6 +733,78 @@ TEST_F(Cli, RunsAreByteIdenticalApartFromTimings) {
   a["partition.json"] = strip(a["partition.json"]);
   b["partition.json"] = strip(b["partition.json"]);
   EXPECT_EQ(a, b);  // every file: JSON, DOT, PCD, PNG and SVG
+}
+
+/// The names in `folder` that start with `prefix` and end with `extension`.
+std::set<std::string> namesIn(const fs::path& folder, const std::string& prefix, const std::string& extension) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0 && entry.path().extension() == extension) names.insert(name);
+  }
+  return names;
+}
+
+TEST_F(Cli, OnePicturePerLocalMapOnlyWithPictures) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("partition " + input + " -q --threads 1 -o " + out.string()).code, 0);
+  const std::size_t groups = readJson(out / "partition.json").at("groups").size();
+  const auto clouds = namesIn(out / "local_maps", "group_", ".pcd");
+  const auto pictures = namesIn(out / "local_maps", "group_", ".png");
+  ASSERT_EQ(clouds.size(), groups);
+  ASSERT_EQ(pictures.size(), groups);
+  for (const std::string& cloud : clouds) {
+    const fs::path picture = out / "local_maps" / fs::path(cloud).replace_extension(".png");
+    EXPECT_GT(fs::file_size(picture), 0u) << picture;
+    expectValidPng(picture);
+  }
+  // The same pictures on two threads.
+  ASSERT_EQ(run("partition " + input + " -q --threads 2 -o " + (dir_ / "two").string()).code, 0);
+  for (const std::string& picture : pictures)
+    EXPECT_EQ(readFile(out / "local_maps" / picture), readFile(dir_ / "two" / "local_maps" / picture)) << picture;
+
+  // Without pictures, none at all; the folder holding pictures is replaced as obsgroup's own.
+  const Result off = run("partition " + input + " -q --no-pictures --force -o " + out.string());
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_EQ(namesIn(out / "local_maps", "group_", ".pcd").size(), groups);
+  for (const auto& entry : fs::recursive_directory_iterator(out))
+    EXPECT_TRUE(entry.path().extension() != ".png" && entry.path().extension() != ".svg") << entry.path();
+}
+
+TEST_F(Cli, TheMapPictureShowsTheRefinedPoses) {
+  // ICP moves members of the office's local maps by up to 0.8 m (topology.json).
+  const std::string input = kData + "/office_2d/office.clf";
+  for (const std::string refine : {"none", "icp"})
+    ASSERT_EQ(run("partition " + input + " -q --refine " + refine + " -o " + (dir_ / refine).string()).code, 0);
+  ASSERT_EQ(readJson(dir_ / "none" / "partition.json").at("groups"),
+            readJson(dir_ / "icp" / "partition.json").at("groups"));
+  EXPECT_NE(readFile(dir_ / "none" / "map.png"), readFile(dir_ / "icp" / "map.png"));
+  EXPECT_NE(readFile(dir_ / "none" / "map.svg"), readFile(dir_ / "icp" / "map.svg"));
+  EXPECT_EQ(readFile(dir_ / "none" / "weights.png"), readFile(dir_ / "icp" / "weights.png"));
+}
+
+TEST_F(Cli, ArcsBetweenGroupsThatDoNotOverlapAreDrawn) {
+  // Every scan 100 m from the previous one: each is a group of its own, and
+  // every arc joins consecutive scans only, with weight 0.
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string log, line;
+  for (int k = 0; std::getline(in, line); ++k) log += shiftedRobotLaserLog(line, 100.0 * k, 0);
+  writeFile(dir_ / "apart.clf", log);
+  const Result r = run("partition " + (dir_ / "apart.clf").string() + " -q -o " + (dir_ / "o").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto topology = readJson(dir_ / "o" / "topology.json");
+  ASSERT_EQ(topology.at("nodes").size(), 24u);
+  ASSERT_EQ(topology.at("arcs").size(), 23u);
+  for (const auto& arc : topology.at("arcs")) EXPECT_EQ(arc.at("weight").get<double>(), 0.0);
+  // Each arc is a dashed stroke of the SVG (a NaN width or opacity drew none).
+  const std::string svg = readFile(dir_ / "o" / "map.svg");
+  std::size_t dashed = 0;
+  for (auto at = svg.find("dasharray:6,4"); at != std::string::npos; at = svg.find("dasharray:6,4", at + 1)) ++dashed;
+  EXPECT_EQ(dashed, 23u);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+  expectValidPng(dir_ / "o" / "map.png");
+  EXPECT_EQ(namesIn(dir_ / "o" / "local_maps", "group_", ".png").size(), 24u);
 }
 
 TEST_F(Cli, AScanFarFromTheOthersIsNamedByItsLine) {

@@ -123,6 +123,9 @@ class ObservationGrouping {
   const WeightMatrix& getWeightMatrix() const { return W_; }
   /// Pi, Psi and work statistics of the last compute().
   const OverlapResult& getOverlap() const { return overlap_result_; }
+  /// The overlap stage as configured (model, voxel leaf, regions, threads),
+  /// e.g. to move the observations to the common frame again for a picture.
+  const SensedSpaceOverlap<PointT>& getSensedSpaceOverlap() const { return overlap_; }
   /// Time spent in each stage of the last compute().
   const GroupingTimings& getTimings() const { return timings_; }
   /// What the user should know about the last compute(), deterministic and

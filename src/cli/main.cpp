@@ -134,7 +134,8 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->check(CLI::NonNegativeNumber);
   command.add_flag("--force", args.force, "replace the results already in the output folder");
   command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr");
-  command.add_flag("!--no-pictures", args.pictures, "do not draw map.png/.svg, weights.png, fiedler.png");
+  command.add_flag("!--no-pictures", args.pictures,
+                   "do not draw map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png");
 }
 
 }  // namespace

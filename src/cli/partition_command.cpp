@@ -136,19 +136,22 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   out.writeText("topology.json", io::topologyJson(topology));
   out.writeText("topology.dot", io::topologyDot(topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(topology));
+  double pictures_s = 0.0;
   if (args.pictures) {
-    SensedSpaceOverlap<PointT> world_frame;
-    world_frame.setVoxelLeafSize(args.voxel);
-    world_frame.setNumberOfThreads(args.threads);
-    world_frame.setSensedSpaceModel(args.sso);
-    world_frame.setRegionParameters(args.region);
+    const auto pictures_start = Clock::now();
+    // The points and regions as the grouping saw them, at the input poses;
+    // map.png draws each observation at its refined pose.
+    const SensedSpaceOverlap<PointT>& world_frame = grouping.getSensedSpaceOverlap();
     const WorldPoints world = world_frame.toWorld(observations);
     ObservationRegions regions;
     const bool tinted = args.sso != SensedSpaceModel::Points;
     if (tinted) regions = world_frame.computeRegions(observations, world);
-    io::writeMapPictures(out, world, poses, partition, topology, tinted ? &regions : nullptr);
+    io::writeMapPictures(out, world, poses, io::refinedPoses(topology, observations.size()), partition, topology,
+                         tinted ? &regions : nullptr);
     io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
     io::writeFiedlerPicture(out, partition);
+    io::writeLocalMapPictures(out, maps, args.threads);
+    pictures_s = secondsSince(pictures_start);
   }
   const double outputs_s = secondsSince(outputs_start);
 
@@ -190,19 +193,20 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   run.warnings = warn.all();
   run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s}, {"graph", t.graph_s},
                   {"partition", t.partition_s}, {"local_maps", maps_s},   {"outputs", outputs_s},
-                  {"threads", args.threads}};
+                  {"pictures", pictures_s},     {"threads", args.threads}};
   out.writeText("partition.json", io::partitionJson(partition, run));
   out.commit();
 
   if (!args.quiet) {
     std::fprintf(stderr,
                  "obsgroup: %zu observations (%zu points), %llu pairs evaluated, %zu overlapping, %zu groups\n"
-                 "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s\n"
+                 "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
+                 " (pictures %.2f s)\n"
                  "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
                  observations.size(), points, static_cast<unsigned long long>(overlap.pairs_evaluated),
                  overlap.pairs.size(), partition.groups.size(), input.load_s, t.overlap_s, t.graph_s,
-                 t.partition_s, maps_s, outputs_s, args.output.c_str(),
-                 args.pictures ? ", map.png/.svg, weights.png, fiedler.png" : "");
+                 t.partition_s, maps_s, outputs_s, pictures_s, args.output.c_str(),
+                 args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
   }
   return 0;
 }

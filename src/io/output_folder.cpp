@@ -40,7 +40,8 @@ bool isResultEntry(const std::string& name) {
 
 /// What obsgroup writes in local_maps/.
 bool isLocalMapEntry(const std::string& name) {
-  return (name.rfind("group_", 0) == 0 && fs::path(name).extension() == ".pcd") || name == "poses.txt";
+  const fs::path extension = fs::path(name).extension();
+  return (name.rfind("group_", 0) == 0 && (extension == ".pcd" || extension == ".png")) || name == "poses.txt";
 }
 
 /// The first entry of the folder that obsgroup did not write, or "".

@@ -2,10 +2,14 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <pcl/point_types.h>
+
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -61,20 +65,31 @@ struct View {
   double py(double y) const { return margin + (max_y - y) * scale; }
 };
 
-View fitView(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions) {
-  Eigen::AlignedBox2d box;
-  for (const auto& p : world.points) box.extend(p.head<2>().cast<double>());
-  for (const auto& p : positions) box.extend(p);
+/// A view of `box` (at least 1 m a side) whose longer side is `longest`
+/// pixels, within the margin, with 20 px more below for a caption. A picture
+/// narrower than `min_width` is widened about the box.
+View fitView(Eigen::AlignedBox2d box, double longest, int min_width = 0) {
   if (box.isEmpty()) box.extend(Eigen::Vector2d::Zero());
   const Eigen::Vector2d size = box.sizes().cwiseMax(1.0);
   View v;
-  const double longest = 1600.0;
   v.scale = longest / size.maxCoeff();
   v.min_x = box.min().x();
   v.max_y = box.max().y();
   v.width = static_cast<int>(std::ceil(size.x() * v.scale + 2 * v.margin));
   v.height = static_cast<int>(std::ceil(size.y() * v.scale + 2 * v.margin + 20));
+  if (v.width < min_width) {
+    v.min_x -= (min_width - v.width) / 2.0 / v.scale;
+    v.width = min_width;
+  }
   return v;
+}
+
+Eigen::AlignedBox2d boxOf(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
+                          const std::vector<Eigen::Vector2d>& positions) {
+  Eigen::AlignedBox2d box;
+  for (const Eigen::Vector3f* p = begin; p != end; ++p) box.extend(p->head<2>().cast<double>());
+  for (const auto& p : positions) box.extend(p);
+  return box;
 }
 
 std::uint32_t argbOf(const Rgb& c) {
@@ -115,8 +130,23 @@ void tintRegions(const ObservationRegions& regions, const Partition& partition, 
   }
 }
 
-/// The points, one pixel (or a 2x2 block when they are few) each, over the
-/// tinted regions when there are some.
+/// One pixel per point, or a 2x2 block when they are few (fewer than 300000).
+int dotSize(std::size_t points) { return points < 300000 ? 2 : 1; }
+
+/// Points [begin, end) seen from above, `dot` pixels square each, into an
+/// image surface's pixels.
+void plotPoints(const View& v, const Eigen::Vector3f* begin, const Eigen::Vector3f* end, std::uint32_t argb, int dot,
+                unsigned char* data, int stride) {
+  for (const Eigen::Vector3f* p = begin; p != end; ++p) {
+    const int x = static_cast<int>(v.px(p->x())), y = static_cast<int>(v.py(p->y()));
+    for (int dy = 0; dy < dot; ++dy)
+      for (int dx = 0; dx < dot; ++dx)
+        if (x + dx >= 0 && x + dx < v.width && y + dy >= 0 && y + dy < v.height)
+          reinterpret_cast<std::uint32_t*>(data + (y + dy) * stride)[x + dx] = argb;
+  }
+}
+
+/// The points coloured by group over the tinted regions when there are some.
 Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v,
                      const ObservationRegions* regions) {
   Surface surface = imageSurface(v.width, v.height);
@@ -124,20 +154,55 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
   unsigned char* data = cairo_image_surface_get_data(surface.get());
   const int stride = cairo_image_surface_get_stride(surface.get());
   if (regions) tintRegions(*regions, partition, v, data, stride);
-  const int dot = world.points.size() < 300000 ? 2 : 1;
-  for (int i = 0; i < world.size(); ++i) {
-    const Rgb c = groupColour(partition.group_of[i]);
-    const std::uint32_t argb = argbOf(c);
-    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
-      const int x = static_cast<int>(v.px(p->x())), y = static_cast<int>(v.py(p->y()));
-      for (int dy = 0; dy < dot; ++dy)
-        for (int dx = 0; dx < dot; ++dx)
-          if (x + dx >= 0 && x + dx < v.width && y + dy >= 0 && y + dy < v.height)
-            reinterpret_cast<std::uint32_t*>(data + (y + dy) * stride)[x + dx] = argb;
-    }
-  }
+  const int dot = dotSize(world.points.size());
+  for (int i = 0; i < world.size(); ++i)
+    plotPoints(v, world.begin(i), world.end(i), argbOf(groupColour(partition.group_of[i])), dot, data, stride);
   cairo_surface_mark_dirty(surface.get());
   return surface;
+}
+
+/// An arrow from (x, y), in pixels, `length` long towards `heading` (radians
+/// from the x axis, counter-clockwise as seen from above); stroke it after.
+void arrowPath(cairo_t* cr, double x, double y, double heading, double length) {
+  const double dx = std::cos(heading) * length, dy = -std::sin(heading) * length;
+  cairo_move_to(cr, x, y);
+  cairo_line_to(cr, x + dx, y + dy);
+  cairo_line_to(cr, x + 0.7 * dx - 0.25 * dy, y + 0.7 * dy + 0.25 * dx);
+  cairo_move_to(cr, x + dx, y + dy);
+  cairo_line_to(cr, x + 0.7 * dx + 0.25 * dy, y + 0.7 * dy - 0.25 * dx);
+}
+
+/// Position on the plane and heading (the x axis projected on it) of a pose.
+void planarPose(const Eigen::Isometry3d& pose, const Eigen::Vector3d& origin, Eigen::Vector2d& position,
+                double& heading) {
+  position = (pose.translation() - origin).head<2>();
+  const Eigen::Vector3d ahead = pose.linear().col(0);
+  heading = std::atan2(ahead.y(), ahead.x());
+}
+
+/// A bar of a round length (1, 2 or 5 times a power of ten metres) at most a
+/// fifth of the drawing wide, labelled, in the top right margin.
+void drawScaleBar(cairo_t* cr, const View& v) {
+  const double most = (v.width - 2 * v.margin) / 5.0 / v.scale;
+  double length = std::pow(10.0, std::floor(std::log10(most)));
+  if (5 * length <= most) length *= 5;
+  else if (2 * length <= most) length *= 2;
+  const double pixels = length * v.scale, x1 = v.width - v.margin, x0 = x1 - pixels, y = v.margin / 2;
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_set_line_width(cr, 2);
+  cairo_new_path(cr);
+  cairo_move_to(cr, x0, y - 4);
+  cairo_line_to(cr, x0, y);
+  cairo_line_to(cr, x1, y);
+  cairo_line_to(cr, x1, y - 4);
+  cairo_stroke(cr);
+  char label[32];
+  std::snprintf(label, sizeof label, "%g m", length);
+  cairo_text_extents_t extents;
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, 12);
+  cairo_text_extents(cr, label, &extents);
+  text(cr, x0 - extents.x_advance - 6, y + 4, label, 12);
 }
 
 void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vector<Eigen::Vector2d>& positions,
@@ -152,13 +217,14 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
     for (int i : partition.groups[g]) centre[g] += positions[i];
     centre[g] /= double(partition.groups[g].size());
   }
-  // Stronger arcs (larger cut weight) are drawn thicker and darker.
+  // Stronger arcs (larger cut weight) are drawn thicker and darker. Arcs of
+  // consecutive observations only weigh 0: when no arc overlaps, all are thin.
   double strongest = 0.0;
   for (const auto& arc : topology.arcs) strongest = std::max(strongest, arc.weight);
   const double dash[] = {6.0, 4.0};
   cairo_set_dash(cr, dash, 2, 0);
   for (const auto& arc : topology.arcs) {
-    const double strength = arc.weight / strongest;
+    const double strength = strongest > 0.0 ? arc.weight / strongest : 0.0;
     cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.15 + 0.6 * strength);
     cairo_set_line_width(cr, 0.5 + 2.5 * strength);
     cairo_move_to(cr, v.px(centre[arc.from].x()), v.py(centre[arc.from].y()));
@@ -170,15 +236,9 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
   const double length = std::max(10.0, 0.5 * v.scale);
   for (std::size_t i = 0; i < positions.size(); ++i) {
     const Rgb c = groupColour(partition.group_of[i]);
-    const double x = v.px(positions[i].x()), y = v.py(positions[i].y());
-    const double dx = std::cos(headings[i]) * length, dy = -std::sin(headings[i]) * length;
     cairo_set_source_rgb(cr, c.r * 0.6, c.g * 0.6, c.b * 0.6);
     cairo_set_line_width(cr, 1.5);
-    cairo_move_to(cr, x, y);
-    cairo_line_to(cr, x + dx, y + dy);
-    cairo_line_to(cr, x + 0.7 * dx - 0.25 * dy, y + 0.7 * dy + 0.25 * dx);
-    cairo_move_to(cr, x + dx, y + dy);
-    cairo_line_to(cr, x + 0.7 * dx + 0.25 * dy, y + 0.7 * dy - 0.25 * dx);
+    arrowPath(cr, v.px(positions[i].x()), v.py(positions[i].y()), headings[i], length);
     cairo_stroke(cr);
   }
   // Group labels at their centres.
@@ -202,18 +262,132 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vec
   text(cr, v.margin, v.height - 12, caption);
 }
 
+/// The points of `world`, at the input `poses`, moved to the `drawn` poses:
+/// observation i's by drawn_i poses_i^-1, in double about the origin. A
+/// move within rounding of the identity (an unrefined member) keeps them.
+/// The boxes are not updated.
+WorldPoints atDrawnPoses(const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
+                         const std::vector<Eigen::Isometry3d>& drawn) {
+  WorldPoints moved = world;
+  const int n = world.size();
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Isometry3d move = drawn[i] * poses[i].inverse();
+    const Eigen::Matrix3d R = move.linear();
+    const Eigen::Vector3d t = R * world.origin + move.translation() - world.origin;
+    if ((R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12 && t.cwiseAbs().maxCoeff() < 1e-9) continue;
+    for (std::size_t k = world.offsets[i]; k < world.offsets[i + 1]; ++k)
+      moved.points[k] = (R * world.points[k].cast<double>() + t).cast<float>();
+  }
+  return moved;
+}
+
+/// One local map from above in its own frame: its points (already in
+/// `surface`), its members' poses, the reference's black in a ring.
+void drawLocalMap(cairo_t* cr, const View& v, int group, const LocalMapFrame& frame, std::size_t points) {
+  const Rgb c = groupColour(group);
+  const double length = std::clamp(0.5 * v.scale, 10.0, 30.0);
+  std::size_t reference = 0;
+  for (std::size_t k = 0; k < frame.members.size(); ++k) {
+    if (frame.members[k] == frame.reference) {
+      reference = k;
+      continue;
+    }
+    Eigen::Vector2d position;
+    double heading;
+    planarPose(frame.member_poses[k], Eigen::Vector3d::Zero(), position, heading);
+    cairo_set_source_rgb(cr, c.r * 0.6, c.g * 0.6, c.b * 0.6);
+    cairo_set_line_width(cr, 1.5);
+    arrowPath(cr, v.px(position.x()), v.py(position.y()), heading, length);
+    cairo_stroke(cr);
+  }
+  if (!frame.members.empty()) {
+    Eigen::Vector2d position;
+    double heading;
+    planarPose(frame.member_poses[reference], Eigen::Vector3d::Zero(), position, heading);
+    const double x = v.px(position.x()), y = v.py(position.y());
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 2.5);
+    arrowPath(cr, x, y, heading, 1.3 * length);
+    cairo_stroke(cr);
+    cairo_new_path(cr);
+    cairo_arc(cr, x, y, 6, 0, 2 * M_PI);
+    cairo_set_line_width(cr, 2);
+    cairo_stroke(cr);
+  }
+  drawScaleBar(cr, v);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  char caption[200];
+  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; reference %d (black)", group,
+                frame.members.size(), points, frame.reference);
+  text(cr, v.margin, v.height - 12, caption, 12);
+}
+
+/// local_maps/group_NNN.png of one local map, whose points (in its frame)
+/// are given without the non-finite ones.
+void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFrame& frame,
+                          const std::vector<Eigen::Vector3f>& points) {
+  std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
+  for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
+  const View v = fitView(boxOf(points.data(), points.data() + points.size(), positions), 700.0, 480);
+  Surface surface = imageSurface(v.width, v.height);
+  Context cr(cairo_create(surface.get()), cairo_destroy);
+  cairo_set_source_rgb(cr.get(), 1, 1, 1);
+  cairo_paint(cr.get());
+  cairo_surface_flush(surface.get());
+  plotPoints(v, points.data(), points.data() + points.size(), argbOf(groupColour(group)), dotSize(points.size()),
+             cairo_image_surface_get_data(surface.get()), cairo_image_surface_get_stride(surface.get()));
+  cairo_surface_mark_dirty(surface.get());
+  drawLocalMap(cr.get(), v, group, frame, points.size());
+  char name[64];
+  std::snprintf(name, sizeof name, "local_maps/group_%03d.png", group);
+  writePng(out, name, surface.get());
+}
+
 }  // namespace
 
-void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
-                      const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
-  std::vector<Eigen::Vector2d> positions;
-  std::vector<double> headings;
-  for (const auto& pose : poses) {
-    positions.push_back((pose.translation() - world.origin).head<2>());
-    const Eigen::Vector3d ahead = pose.linear().col(0);
-    headings.push_back(std::atan2(ahead.y(), ahead.x()));
+std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std::size_t observations) {
+  std::vector<Eigen::Isometry3d> poses(observations, Eigen::Isometry3d::Identity());
+  for (const LocalMapFrame& node : topology.nodes)
+    for (std::size_t k = 0; k < node.members.size(); ++k) poses.at(node.members[k]) = node.pose * node.member_poses[k];
+  return poses;
+}
+
+template <typename PointT>
+void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads) {
+  const int n = static_cast<int>(maps.size());
+  std::vector<std::exception_ptr> failures(maps.size());
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 1)
+  for (int g = 0; g < n; ++g) {
+    try {
+      std::vector<Eigen::Vector3f> points;
+      if (maps[g].cloud) {
+        points.reserve(maps[g].cloud->size());
+        for (const PointT& p : maps[g].cloud->points)
+          if (std::isfinite(p.x) && std::isfinite(p.y)) points.emplace_back(p.x, p.y, p.z);
+      }
+      writeLocalMapPicture(out, g, maps[g].frame, points);
+    } catch (...) {
+      failures[g] = std::current_exception();
+    }
   }
-  const View v = fitView(world, positions);
+  for (const auto& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+}
+
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int);
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&, int);
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int);
+
+void writeMapPictures(const OutputFolder& out, const WorldPoints& input_world,
+                      const std::vector<Eigen::Isometry3d>& poses, const std::vector<Eigen::Isometry3d>& drawn,
+                      const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
+  const WorldPoints world = atDrawnPoses(input_world, poses, drawn);
+  std::vector<Eigen::Vector2d> positions(drawn.size());
+  std::vector<double> headings(drawn.size());
+  for (std::size_t i = 0; i < drawn.size(); ++i) planarPose(drawn[i], world.origin, positions[i], headings[i]);
+  const View v = fitView(boxOf(world.points.data(), world.points.data() + world.points.size(), positions), 1600.0);
+  // The regions describe the input poses (they gave W) and stay there.
   const Surface points = rasterPoints(world, partition, v, regions);
 
   Surface png = imageSurface(v.width, v.height);
