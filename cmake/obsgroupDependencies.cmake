@@ -21,3 +21,11 @@ find_package(OpenMP REQUIRED)
 find_package(Spectra 1.0 REQUIRED CONFIG)
 
 set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters pcl_registration)
+
+# FLANN's index headers (refinement's nearest-point search, src/maps/refinement.cpp)
+# call LZ4 in their serialisation code; libflann-dev brings liblz4-dev along.
+find_library(OBSGROUP_LZ4_LIBRARY NAMES lz4 REQUIRED)
+if(NOT TARGET obsgroup::lz4)
+  add_library(obsgroup::lz4 UNKNOWN IMPORTED)
+  set_target_properties(obsgroup::lz4 PROPERTIES IMPORTED_LOCATION "${OBSGROUP_LZ4_LIBRARY}")
+endif()

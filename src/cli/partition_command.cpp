@@ -118,13 +118,14 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   builder.setInterruptFlag(args.interrupt);
   const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
   std::vector<LocalMapFrame> frames;
+  RefinementReport refinement;  // one line for the run, not one per map
   for (std::size_t g = 0; g < maps.size(); ++g) {
     frames.push_back(maps[g].frame);
     if (!maps[g].filtered) warn("local map " + std::to_string(g) + ": too large for a " +
                                           std::to_string(map_voxel) + " m voxel filter; written unfiltered");
-    const std::string refined = maps[g].refinement.warning();
-    if (!refined.empty()) warn("local map " + std::to_string(g) + ": " + refined);
+    refinement += maps[g].refinement;
   }
+  if (!refinement.warning().empty()) warn("refinement: " + refinement.warning());
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& o : observations) poses.push_back(o.pose);
   const TopologicalMap topology = buildTopologicalMap(std::move(frames), grouping.getWeightMatrix(), poses, args.threads);
@@ -188,7 +189,9 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
                     {"point_tests", overlap.point_tests},
                     {"edges", overlap.pairs.size()},
                     {"groups", partition.groups.size()},
-                    {"local_map_points", map_points}};
+                    {"local_map_points", map_points},
+                    {"refined_members", refinement.moved},
+                    {"kept_members", refinement.members - refinement.moved}};
   const auto& t = grouping.getTimings();
   run.warnings = warn.all();
   run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s}, {"graph", t.graph_s},

@@ -1,8 +1,11 @@
 #include "obsgroup/maps/refinement.h"
 
 #include <pcl/filters/voxel_grid.h>
-#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
+
+#include <flann/algorithms/dist.h>
+#include <flann/algorithms/kdtree_single_index.h>
+#include <flann/util/result_set.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -43,6 +46,18 @@ std::string RefinementReport::warning() const {
     text += "; " + std::to_string(pairs_partial) + " of " + std::to_string(pairs) +
             " pairs constrain only some directions (a corridor): the others keep the input poses";
   return text;
+}
+
+RefinementReport& RefinementReport::operator+=(const RefinementReport& other) {
+  members += other.members;
+  moved += other.moved;
+  kept_not_better += other.kept_not_better;
+  kept_beyond_bound += other.kept_beyond_bound;
+  kept_unaligned += other.kept_unaligned;
+  pairs += other.pairs;
+  pairs_refused += other.pairs_refused;
+  pairs_partial += other.pairs_partial;
+  return *this;
 }
 
 namespace {
@@ -96,12 +111,21 @@ Vector6d logarithm(const Eigen::Isometry3d& pose, bool planar) {
 double rotationAngle(const Eigen::Isometry3d& pose) { return Eigen::AngleAxisd(pose.linear()).angle(); }
 
 /// A member thinned for alignment, with a surface normal per point (zero
-/// where the neighbourhood is no line or plane) and a search tree.
+/// where the neighbourhood is no line or plane) and a search tree. The tree
+/// is FLANN's single-tree index queried directly: its knnSearch opens an
+/// OpenMP region per call, which cost more than the search for one point.
 struct PreparedMember {
+  using Index = flann::KDTreeSingleIndex<flann::L2_Simple<float>>;
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
   std::vector<Eigen::Vector3d> normals;
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree;  ///< built only when `searchable`
-  bool searchable = false;
+  std::unique_ptr<Index> index;  ///< null when the cloud is too small to match against
+
+  /// The `k` nearest points of `query` (fewer if the cloud is smaller), by
+  /// squared distance; `result` is the caller's, reused across queries.
+  void nearest(const Eigen::Vector3f& query, flann::KNNSimpleResultSet<float>& result) const {
+    result.clear();
+    index->findNeighbors(result, query.data(), flann::SearchParams(-1));
+  }
 };
 
 std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel, bool planar) {
@@ -118,22 +142,25 @@ std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel
   } else {
     member->cloud = raw;
   }
-  const auto& cloud = *member->cloud;
+  auto& cloud = *member->cloud;
   member->normals.assign(cloud.size(), Eigen::Vector3d::Zero());
   if (cloud.size() < 3) return member;
-  member->tree.setInputCloud(member->cloud);
-  member->searchable = true;
+  const flann::Matrix<float> data(&cloud.points[0].x, cloud.size(), 3, sizeof(pcl::PointXYZ));
+  member->index = std::make_unique<PreparedMember::Index>(data, flann::KDTreeSingleIndexParams(10));
+  member->index->buildIndex();
   // A line (2D) or plane (3D) fitted to the nearest points; a corner or a
   // scatter gives no normal, and the point then matches nothing.
-  const int k = planar ? 6 : 10;
+  const std::size_t k = std::min<std::size_t>(planar ? 6 : 10, cloud.size());
   const double max_spread = std::max(0.5, 8 * voxel);
-  pcl::Indices neighbours;
-  std::vector<float> distances;
+  flann::KNNSimpleResultSet<float> result(k);
+  std::vector<std::size_t> neighbours(k);
+  std::vector<float> distances(k);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    member->tree.nearestKSearch(cloud[i], k, neighbours, distances);
+    member->nearest(cloud[i].getVector3fMap(), result);
+    result.copy(neighbours.data(), distances.data(), k);
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     int used = 0;
-    for (std::size_t j = 0; j < neighbours.size(); ++j)
+    for (std::size_t j = 0; j < k; ++j)
       if (distances[j] <= max_spread * max_spread) {
         mean += cloud[neighbours[j]].getVector3fMap().cast<double>();
         ++used;
@@ -141,7 +168,7 @@ std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel
     if (used < 3) continue;
     mean /= used;
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (std::size_t j = 0; j < neighbours.size(); ++j)
+    for (std::size_t j = 0; j < k; ++j)
       if (distances[j] <= max_spread * max_spread) {
         const Eigen::Vector3d d = cloud[neighbours[j]].getVector3fMap().cast<double>() - mean;
         covariance += d * d.transpose();
@@ -159,17 +186,19 @@ std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel
 }
 
 /// Point-to-surface residual of `x` (in the target's frame) against its
-/// nearest target point; false when none lies within `gate` or it has no normal.
-bool residual(const PreparedMember& target, const Eigen::Vector3d& x, double gate, double& r,
-              Eigen::Vector3d& normal) {
-  if (!target.searchable) return false;
-  pcl::Indices index(1);
-  std::vector<float> distance(1);
-  const pcl::PointXYZ query(float(x.x()), float(x.y()), float(x.z()));
-  if (target.tree.nearestKSearch(query, 1, index, distance) < 1 || distance[0] > gate * gate) return false;
-  normal = target.normals[index[0]];
+/// nearest target point; false when none lies within `gate` or it has no
+/// normal. `nearest` is a one-point result set the caller reuses.
+bool residual(const PreparedMember& target, const Eigen::Vector3d& x, double gate, double& r, Eigen::Vector3d& normal,
+              flann::KNNSimpleResultSet<float>& nearest) {
+  if (!target.index) return false;
+  target.nearest(x.cast<float>(), nearest);
+  std::size_t index;
+  float distance;
+  nearest.copy(&index, &distance, 1);
+  if (!(distance <= gate * gate)) return false;
+  normal = target.normals[index];
   if (normal.isZero()) return false;
-  r = normal.dot(x - target.cloud->points[index[0]].getVector3fMap().cast<double>());
+  r = normal.dot(x - target.cloud->points[index].getVector3fMap().cast<double>());
   return true;
 }
 
@@ -269,6 +298,7 @@ struct PairAlignment {
 PairAlignment alignPair(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& guess,
                         const Freedom& freedom, const RefinementParameters& parameters) {
   PairAlignment result;
+  flann::KNNSimpleResultSet<float> nearest(1);
   const auto& points = source.cloud->points;
   if (points.size() < 6 || target.cloud->size() < 6) return result;
   const double inlier = parameters.inlier_distance;
@@ -291,7 +321,7 @@ PairAlignment alignPair(const PreparedMember& source, const PreparedMember& targ
       const Eigen::Vector3d x = pose * p.getVector3fMap().cast<double>();
       double r;
       Eigen::Vector3d n;
-      if (!residual(target, x, g, r, n)) continue;
+      if (!residual(target, x, g, r, n, nearest)) continue;
       Vector6d J;
       J << n, x.cross(n);
       const double w = 1.0 / (1.0 + (r / inlier) * (r / inlier));  // Cauchy: far matches barely pull
@@ -480,6 +510,7 @@ double consistency(int k, const std::vector<int>& neighbours, const std::vector<
   const auto& points = members[k]->cloud->points;
   if (points.empty() || neighbours.empty()) return 0;
   const double inlier = parameters.inlier_distance;
+  flann::KNNSimpleResultSet<float> nearest(1);
   std::vector<Eigen::Isometry3d> into;  // k's frame into each neighbour's
   for (int j : neighbours) into.push_back(X[j].inverse() * X[k]);
   double sum = 0;
@@ -489,7 +520,7 @@ double consistency(int k, const std::vector<int>& neighbours, const std::vector<
     for (std::size_t s = 0; s < neighbours.size(); ++s) {
       double r;
       Eigen::Vector3d n;
-      if (residual(*members[neighbours[s]], into[s] * local, 3 * inlier, r, n))
+      if (residual(*members[neighbours[s]], into[s] * local, 3 * inlier, r, n, nearest))
         best = std::max(best, 1.0 - (r / inlier) * (r / inlier));
     }
     sum += best;
@@ -524,7 +555,8 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
 
   std::vector<std::unique_ptr<PreparedMember>> members;
   members.reserve(m);
-  for (const auto& p : points) members.push_back(prepare(p, parameters.alignment_voxel, freedom.planar));
+  const double voxel = planar ? parameters.alignment_voxel : parameters.alignment_voxel_3d;
+  for (const auto& p : points) members.push_back(prepare(p, voxel, freedom.planar));
 
   const std::vector<Eigen::Isometry3d> input = frame.member_poses;
   std::vector<GraphEdge> edges;

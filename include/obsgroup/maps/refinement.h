@@ -31,8 +31,10 @@ std::string toString(Refinement refinement);
 Refinement refinementFromString(const std::string& name);
 
 struct RefinementParameters {
-  /// Voxel leaf the members are thinned to before alignment, metres.
+  /// Voxel leaf planar scans are thinned to before alignment, metres...
   double alignment_voxel = 0.05;
+  /// ...and 3D clouds, whose surfaces hold far more points than a scan's lines.
+  double alignment_voxel_3d = 0.1;
   /// Correspondence gate of the first alignment iteration, metres; it
   /// shrinks towards 3 x inlier_distance. Bounds the pose error that can be corrected.
   double max_correspondence_distance = 0.5;
@@ -71,6 +73,8 @@ struct RefinementReport {
   /// One line for the run's warnings, or "" when nothing deserves one
   /// (members kept because their input pose was already as good are normal).
   std::string warning() const;
+  /// Adds another map's counts: one report, and one warning, for a whole run.
+  RefinementReport& operator+=(const RefinementReport& other);
 };
 
 /// The finite points of one member in its own sensor frame.
