@@ -83,8 +83,10 @@ using MemberPoints = std::vector<Eigen::Vector3f>;
 /// Refines `frame.member_poses` (the reference stays the identity).
 /// `points[k]` belongs to `frame.members[k]`; `pairs` are the (target,
 /// source) member positions to align, spanning tree pairs first. `planar`
-/// data (every point and pose in one horizontal plane) is refined in SE(2):
-/// z, roll and pitch are left exactly as they were.
+/// says every point lies in one plane (2D scans: normals are fitted in it).
+/// Members whose poses all lie in one horizontal plane (a ground robot,
+/// with a laser or a depth camera) are refined in SE(2): z, roll and pitch
+/// are left exactly as they were.
 RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
                                    const std::vector<std::pair<int, int>>& pairs, bool planar,
                                    const RefinementParameters& parameters, LocalMapFrame& frame);
