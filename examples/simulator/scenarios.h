@@ -24,9 +24,9 @@ struct Building {
 };
 
 /// The buildings by key: "office" (office(), officeRoute(150),
-/// officeSecondVisitRoute(60)), "loop" (loopBuilding(), loopBuildingRoute(300),
-/// loopBuildingSecondVisitRoute(100)) and "rooms20" (twentyRoomBuilding(),
-/// twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(200)).
+/// officeSecondVisitRoute(40)), "loop" (loopBuilding(), loopBuildingRoute(300),
+/// loopBuildingSecondVisitRoute(70)) and "rooms20" (twentyRoomBuilding(),
+/// twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)).
 /// Throws std::invalid_argument for another key.
 Building makeBuilding(const std::string& key);
 /// The keys of makeBuilding, smallest building first.
