@@ -391,7 +391,7 @@ std::vector<Pose2D> loopBuildingRoute(int count) {
 
 std::vector<Pose2D> loopBuildingSecondVisitRoute(int count) {
   // Run 1 keeps to the corridors' middles and walks a diamond in each room;
-  // this visit keeps 0.4 m to one side and walks rectangles the other way,
+  // this visit keeps 0.4 to 0.5 m to one side and walks rectangles the other way,
   // bent round the table of north room 2.
   const double xs[] = {3.0, 14.33, 25.67, 37.0};
   const auto door = [&xs](int room) { return (xs[room] + xs[room + 1]) / 2; };
