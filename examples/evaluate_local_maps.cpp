@@ -465,7 +465,9 @@ std::string summary(const std::vector<Row>& rows) {
     return *std::min_element(rows.begin(), rows.end(), [&key](const Row& a, const Row& b) { return key(a) < key(b); });
   };
   const Row& median = best([](const Row& r) { return r.localization.errors.t50; });
-  const Row& failures = best([](const Row& r) { return r.localization.failures; });
+  // Ties (several cuts with no failure) go to the lower median error.
+  const Row& failures =
+      best([](const Row& r) { return std::make_pair(r.localization.failures, r.localization.errors.t50); });
   return format("Lowest median error: %s (%.1f cm). Fewest failures: %s (%.0f %%).\n", label(median).c_str(),
                 100 * median.localization.errors.t50, label(failures).c_str(), 100 * failures.localization.failures);
 }
