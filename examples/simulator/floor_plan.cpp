@@ -269,6 +269,25 @@ std::vector<Pose2D> officeRoute(int count) {
   return evenlySpaced(waypoints, count);
 }
 
+std::vector<Pose2D> officeSecondVisitRoute(int count) {
+  // Run 1 keeps to the corridor's middle (y = 1.25) and goes round each room
+  // clockwise on a diamond; this visit keeps to a lane on either side of it
+  // (0.4 m clear of the pillar) and goes round a rectangle counter-clockwise.
+  constexpr double westwards = 1.7, eastwards = 1.0;
+  std::vector<Eigen::Vector2d> waypoints{{31.0, westwards}};
+  const auto visit = [&waypoints](int room, double lane) {
+    const double door = room * 8.0 + 4.0;
+    waypoints.insert(waypoints.end(), {{door, lane}, {door, 3.6}, {door + 2.2, 4.3}, {door + 1.8, 6.8},
+                                        {door - 2.2, 6.8}, {door - 2.2, 4.3}, {door, 3.6}, {door, lane}});
+  };
+  visit(2, westwards);  // room 3
+  visit(0, westwards);  // room 1, then back east
+  visit(1, eastwards);
+  visit(3, eastwards);
+  waypoints.emplace_back(31.0, eastwards);
+  return evenlySpaced(waypoints, count);
+}
+
 FloorPlan longBuilding(double length) {
   FloorPlan plan;
   // Corridor y in [6, 9]; rooms 8 m wide below (y 0..6) and above (y 9..15), one door each.
@@ -370,6 +389,35 @@ std::vector<Pose2D> loopBuildingRoute(int count) {
   return evenlySpaced(waypoints, count);
 }
 
+std::vector<Pose2D> loopBuildingSecondVisitRoute(int count) {
+  // Run 1 keeps to the corridors' middles and walks a diamond in each room;
+  // this visit keeps 0.4 to 0.5 m to one side and walks rectangles the other way,
+  // bent round the table of north room 2.
+  const double xs[] = {3.0, 14.33, 25.67, 37.0};
+  const auto door = [&xs](int room) { return (xs[room] + xs[room + 1]) / 2; };
+  std::vector<Eigen::Vector2d> waypoints{{1.9, 13.0}};
+  const auto north = [&waypoints](double x, double lane) {
+    waypoints.insert(waypoints.end(), {{x, lane}, {x, 21.5}, {x - 3.8, 20.5}, {x - 3.5, 15.0}, {x + 3.5, 15.5},
+                                        {x + 2.5, 18.5}, {x, 21.5}, {x, lane}});
+  };
+  const auto south = [&waypoints](double x, double lane) {
+    waypoints.insert(waypoints.end(), {{x, lane}, {x, 4.5}, {x + 3.8, 5.5}, {x + 3.5, 11.0}, {x - 3.5, 10.5},
+                                        {x - 3.8, 5.5}, {x, 4.5}, {x, lane}});
+  };
+  waypoints.emplace_back(1.9, 24.1);  // north, then clockwise round the ring
+  north(door(1), 24.1);
+  north(door(2), 24.1);
+  waypoints.emplace_back(38.0, 24.1);
+  waypoints.emplace_back(38.0, 1.9);
+  south(door(2), 1.9);
+  south(door(0), 1.9);
+  south(door(1), 1.1);  // back east, then all the way west and up to north room 1
+  waypoints.emplace_back(1.1, 1.1);
+  waypoints.emplace_back(1.1, 24.9);
+  north(door(0), 24.9);
+  return evenlySpaced(waypoints, count);
+}
+
 namespace {
 
 /// One room of twentyRoomBuilding(): x0..x1 along the ring, its door wall
@@ -397,6 +445,43 @@ std::vector<RingRoom> twentyRooms() {
 /// How far inside its walls the route goes round a room of twentyRooms();
 /// furniture stays at least 0.9 m clear of that loop.
 constexpr double kRoomLoopInset = 1.6;
+
+/// Through the door, once round the room `inset` metres inside its walls,
+/// and back out to the corridor's lane at `corridor_y`.
+void visitRingRoom(const RingRoom& r, double corridor_y, bool clockwise, double inset,
+                   std::vector<Eigen::Vector2d>& waypoints) {
+  const double inward = r.back > r.front ? 1.0 : -1.0;
+  const double x0 = r.x0 + inset, x1 = r.x1 - inset;
+  const double near_y = r.front + inward * inset, far_y = r.back - inward * inset;
+  const Eigen::Vector2d door(r.door, corridor_y), entry(r.door, near_y);
+  std::vector<Eigen::Vector2d> loop{{x1, near_y}, {x1, far_y}, {x0, far_y}, {x0, near_y}};
+  if (clockwise) std::reverse(loop.begin(), loop.end());
+  waypoints.push_back(door);
+  waypoints.push_back(entry);
+  waypoints.insert(waypoints.end(), loop.begin(), loop.end());
+  waypoints.push_back(entry);
+  waypoints.push_back(door);
+}
+
+/// The rooms in the order twentyRoomBuildingRoute() enters them: those onto
+/// the south corridor eastwards, then those onto the north one westwards.
+std::vector<const RingRoom*> runOneOrder(const std::vector<RingRoom>& rooms) {
+  std::vector<const RingRoom*> order;
+  for (bool south : {true, false}) {
+    std::vector<const RingRoom*> side;
+    for (const RingRoom& r : rooms)
+      if ((r.front < 20.0) == south) side.push_back(&r);
+    std::sort(side.begin(), side.end(), [south](const RingRoom* a, const RingRoom* b) {
+      return south ? a->door < b->door : a->door > b->door;
+    });
+    order.insert(order.end(), side.begin(), side.end());
+  }
+  return order;
+}
+
+/// Run 1 goes round its k-th room clockwise and counter-clockwise in turn,
+/// clockwise first.
+bool runOneClockwise(std::size_t k) { return k % 2 == 0; }
 
 }  // namespace
 
@@ -470,43 +555,46 @@ FloorPlan twentyRoomBuilding() {
 
 std::vector<Pose2D> twentyRoomBuildingRoute(int count) {
   const std::vector<RingRoom> rooms = twentyRooms();
-  // Through the door, once round the room inside its walls (clockwise and
-  // counter-clockwise in turn), and back out to the corridor's middle.
   std::vector<Eigen::Vector2d> waypoints;
-  const auto visit = [&waypoints](const RingRoom& r, double corridor_y, bool clockwise) {
-    const double inward = r.back > r.front ? 1.0 : -1.0;
-    const double x0 = r.x0 + kRoomLoopInset, x1 = r.x1 - kRoomLoopInset;
-    const double near_y = r.front + inward * kRoomLoopInset, far_y = r.back - inward * kRoomLoopInset;
-    const Eigen::Vector2d door(r.door, corridor_y), entry(r.door, near_y);
-    std::vector<Eigen::Vector2d> loop{{x1, near_y}, {x1, far_y}, {x0, far_y}, {x0, near_y}};
-    if (clockwise) std::reverse(loop.begin(), loop.end());
-    waypoints.push_back(door);
-    waypoints.push_back(entry);
-    waypoints.insert(waypoints.end(), loop.begin(), loop.end());
-    waypoints.push_back(entry);
-    waypoints.push_back(door);
-  };
-  // The rooms opening onto the south (north) corridor, in the order the
-  // route passes their doors.
-  const auto along = [&rooms](bool south, bool eastwards) {
-    std::vector<const RingRoom*> list;
-    for (const RingRoom& r : rooms)
-      if ((r.front < 20.0) == south) list.push_back(&r);
-    std::sort(list.begin(), list.end(), [eastwards](const RingRoom* a, const RingRoom* b) {
-      return eastwards ? a->door < b->door : a->door > b->door;
-    });
-    return list;
-  };
   constexpr double south_y = 9.5, north_y = 30.5, west_x = 1.5, east_x = 44.5;
   waypoints.emplace_back(west_x, south_y);
-  bool clockwise = false;
-  for (const RingRoom* r : along(true, true)) visit(*r, south_y, clockwise = !clockwise);
-  waypoints.emplace_back(east_x, south_y);
-  waypoints.emplace_back(east_x, north_y);
-  for (const RingRoom* r : along(false, false)) visit(*r, north_y, clockwise = !clockwise);
+  const std::vector<const RingRoom*> order = runOneOrder(rooms);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const bool south = order[k]->front < 20.0;
+    if (!south && order[k - 1]->front < 20.0) {  // up the east corridor
+      waypoints.emplace_back(east_x, south_y);
+      waypoints.emplace_back(east_x, north_y);
+    }
+    visitRingRoom(*order[k], south ? south_y : north_y, runOneClockwise(k), kRoomLoopInset, waypoints);
+  }
   waypoints.emplace_back(west_x, north_y);
   waypoints.emplace_back(west_x, south_y);  // back where it started: the loop closes
   waypoints.emplace_back(8.0, south_y);
+  return evenlySpaced(waypoints, count);
+}
+
+std::vector<Pose2D> twentyRoomBuildingSecondVisitRoute(int count) {
+  const std::vector<RingRoom> rooms = twentyRooms();
+  const std::vector<const RingRoom*> run_one = runOneOrder(rooms);
+  // Clockwise round the ring in lanes 0.4 m off run 1's, each room entered
+  // the other way round than run 1 and 0.4 m further from its walls (the
+  // furniture leaves 0.9 m round run 1's loop, so 0.5 m round this one).
+  constexpr double south_y = 9.9, north_y = 30.1, west_x = 1.9, east_x = 44.1, inset = kRoomLoopInset + 0.4;
+  std::vector<Eigen::Vector2d> waypoints{{west_x, 20.0}, {west_x, north_y}};
+  std::vector<std::size_t> order(run_one.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = order.size() - 1 - k;  // run 1's, reversed
+  bool turned = false;
+  for (std::size_t k : order) {
+    const bool south = run_one[k]->front < 20.0;
+    if (south && !turned) {
+      waypoints.emplace_back(east_x, north_y);
+      waypoints.emplace_back(east_x, south_y);
+      turned = true;
+    }
+    visitRingRoom(*run_one[k], south ? south_y : north_y, !runOneClockwise(k), inset, waypoints);
+  }
+  waypoints.emplace_back(west_x, south_y);
+  waypoints.emplace_back(west_x, 20.0);  // back where it started
   return evenlySpaced(waypoints, count);
 }
 

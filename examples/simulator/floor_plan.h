@@ -128,6 +128,12 @@ std::vector<Pose2D> threeRoomsPoses(int per_room = 5);
 FloorPlan office();
 /// A route along the corridor that visits every room, `count` poses.
 std::vector<Pose2D> officeRoute(int count = 77);
+/// The robot's next visit to office(): it starts at the corridor's east end
+/// and visits the rooms in another order (3, 1, 2, 4), going round each the
+/// other way and nearer its walls, and keeps to other lanes of the corridor
+/// than officeRoute, so that few of its poses and headings repeat run 1's.
+/// `count` poses.
+std::vector<Pose2D> officeSecondVisitRoute(int count = 60);
 
 /// A long building for scaling runs: `length` metres of 3 m corridor with
 /// 8 x 6 m rooms on both sides, each with a door; the local density of the
@@ -143,6 +149,12 @@ FloorPlan loopBuilding();
 /// A route around the whole ring that enters every room and closes the loop
 /// where it started, `count` poses.
 std::vector<Pose2D> loopBuildingRoute(int count = 260);
+/// The robot's next visit to loopBuilding(): it starts half-way up the west
+/// corridor, goes round the ring clockwise (run 1 goes counter-clockwise),
+/// in other lanes, and visits the rooms in another order (north 2, north 3,
+/// south 3, south 1, south 2, north 1) on rectangular paths, where run 1
+/// walks diamonds. `count` poses.
+std::vector<Pose2D> loopBuildingSecondVisitRoute(int count = 100);
 
 /// A building of twenty rooms around a loop (46 x 40 m): a 3 m corridor
 /// ring around a block of eight rooms (four opening south, four north) and
@@ -155,5 +167,10 @@ FloorPlan twentyRoomBuilding();
 /// twentyRoomBuilding(), goes once round each room (facing all four ways)
 /// and closes the loop where it started, `count` poses.
 std::vector<Pose2D> twentyRoomBuildingRoute(int count = 600);
+/// The robot's next visit to twentyRoomBuilding(): clockwise round the ring
+/// (run 1 goes counter-clockwise), in other lanes, entering the rooms in the
+/// order their doors come that way, going round each the other way than
+/// run 1 and further from its walls. `count` poses.
+std::vector<Pose2D> twentyRoomBuildingSecondVisitRoute(int count = 300);
 
 }  // namespace obsgroup::sim

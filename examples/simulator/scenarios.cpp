@@ -14,12 +14,14 @@ constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
 Building makeBuilding(const std::string& key) {
-  if (key == "office") return {key, "Office: a corridor and four rooms", office(), officeRoute(150)};
+  if (key == "office")
+    return {key, "Office: a corridor and four rooms", office(), officeRoute(150), officeSecondVisitRoute(40)};
   if (key == "loop")
-    return {key, "Building with a loop: a corridor ring around six rooms", loopBuilding(), loopBuildingRoute(300)};
+    return {key, "Building with a loop: a corridor ring around six rooms", loopBuilding(), loopBuildingRoute(300),
+            loopBuildingSecondVisitRoute(70)};
   if (key == "rooms20")
     return {key, "Twenty rooms around a loop: a corridor ring, rooms inside and outside it", twentyRoomBuilding(),
-            twentyRoomBuildingRoute(600)};
+            twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)};
   throw std::invalid_argument("unknown building '" + key + "' (office, loop or rooms20)");
 }
 

@@ -14,18 +14,20 @@
 
 namespace obsgroup::sim {
 
-/// A floor plan and the route a robot takes through it.
+/// A floor plan and the routes a robot takes through it.
 struct Building {
   std::string key;    ///< short name for command lines: "office", "loop", "rooms20"
   std::string title;  ///< for reports
   FloorPlan plan;
-  std::vector<Pose2D> route;
+  std::vector<Pose2D> route;        ///< run 1: the route its maps are built from
+  std::vector<Pose2D> second_visit;  ///< run 2: the robot's next visit, another way through the same rooms
 };
 
-/// The buildings by key: "office" (office(), officeRoute(150)), "loop"
-/// (loopBuilding(), loopBuildingRoute(300)) and "rooms20"
-/// (twentyRoomBuilding(), twentyRoomBuildingRoute(600)). Throws
-/// std::invalid_argument for another key.
+/// The buildings by key: "office" (office(), officeRoute(150),
+/// officeSecondVisitRoute(40)), "loop" (loopBuilding(), loopBuildingRoute(300),
+/// loopBuildingSecondVisitRoute(70)) and "rooms20" (twentyRoomBuilding(),
+/// twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)).
+/// Throws std::invalid_argument for another key.
 Building makeBuilding(const std::string& key);
 /// The keys of makeBuilding, smallest building first.
 std::vector<std::string> buildingKeys();
