@@ -396,7 +396,7 @@ struct Row {
   std::string cut;
   Refinement refinement = Refinement::None;
   std::size_t maps = 0;
-  int fell_back = 0;
+  RefinementReport refined;  ///< summed over the maps
   Spread members;
   Localization localization;
 };
@@ -411,7 +411,7 @@ Row measure(const Evaluation& e, const Cut& cut, Refinement refinement) {
   row.cut = cut.name;
   row.refinement = refinement;
   row.maps = maps.size();
-  for (const auto& map : maps) row.fell_back += map.fell_back;
+  for (const auto& map : maps) row.refined += map.refinement;
   row.members = memberPoseErrors(maps, e.data.first.truth);
   row.localization = localize(e.data, cut.partition, maps);
   return row;
@@ -444,8 +444,7 @@ void runInParallel(std::size_t count, const Task& task) {
 std::string refinementName(const Row& row) {
   if (row.refinement == Refinement::None) return "none";
   std::string name = row.refinement == Refinement::Lum ? "LUM" : "ICP";
-  if (row.fell_back > 0) name += format(" (%d fell back)", row.fell_back);
-  return name;
+  return name + format(" (%d of %d moved)", row.refined.moved, row.refined.members);
 }
 
 std::string tableLine(const Row& r, double coverage) {
