@@ -173,24 +173,28 @@ std::unique_ptr<PreparedMember> prepare(const MemberPoints& points, double voxel
         const Eigen::Vector3d d = cloud[neighbours[j]].getVector3fMap().cast<double>() - mean;
         covariance += d * d.transpose();
       }
+    Eigen::Vector3d& normal = member->normals[i];
     if (planar) {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(covariance.topLeftCorner<2, 2>());
-      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1])
-        member->normals[i] << eigen.eigenvectors().col(0), 0;
+      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1]) normal << eigen.eigenvectors().col(0), 0;
     } else {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1]) member->normals[i] = eigen.eigenvectors().col(0);
+      if (eigen.eigenvalues()[0] < 0.1 * eigen.eigenvalues()[1]) normal = eigen.eigenvectors().col(0);
     }
+    // Towards the sensor (the frame's origin), as pcl::flipNormalTowardsViewpoint:
+    // the two faces of a thin wall then point apart and do not match.
+    if (normal.dot(cloud[i].getVector3fMap().cast<double>()) > 0) normal = -normal;
   }
   return member;
 }
 
 /// Point-to-surface residual of `x` (in the target's frame, its surface
-/// normal `source_normal` turned into that frame too) against its nearest
-/// target point; false when none lies within `gate`, either point has no
-/// normal, or the normals differ by more than about 35 degrees: a floor
-/// point whose nearest neighbour lies on the wall would pull the pose
-/// sideways (measured: 27 cm off exact depth-camera poses before this test).
+/// normal `source_normal` turned into that frame too, zero if it has none)
+/// against its nearest target point; false when none lies within `gate`,
+/// the target point has no normal, or the normals differ by more than about
+/// 35 degrees. Normals face their sensor, so this rejects a floor point
+/// matched to a wall and, above all, the far face of a thin wall seen
+/// through a door: that pulled exact depth-camera poses up to 30 cm away.
 /// `nearest` is a one-point result set the caller reuses.
 bool residual(const PreparedMember& target, const Eigen::Vector3d& x, const Eigen::Vector3d& source_normal,
               double gate, double& r, Eigen::Vector3d& normal, flann::KNNSimpleResultSet<float>& nearest) {
@@ -201,7 +205,7 @@ bool residual(const PreparedMember& target, const Eigen::Vector3d& x, const Eige
   nearest.copy(&index, &distance, 1);
   if (!(distance <= gate * gate)) return false;
   normal = target.normals[index];
-  if (normal.isZero() || (!source_normal.isZero() && std::abs(normal.dot(source_normal)) < 0.8)) return false;
+  if (normal.isZero() || (!source_normal.isZero() && normal.dot(source_normal) < 0.8)) return false;
   r = normal.dot(x - target.cloud->points[index].getVector3fMap().cast<double>());
   return true;
 }
