@@ -578,6 +578,80 @@ bool posesArePlanar(const std::vector<Eigen::Isometry3d>& poses) {
 
 }  // namespace
 
+namespace {
+
+/// The pairwise alignments of a group and what they connect.
+struct PairGraph {
+  std::vector<GraphEdge> edges;             ///< the usable alignments
+  std::vector<std::vector<int>> neighbours;  ///< per member: every member it was paired with
+  std::vector<bool> aligned;                 ///< per member: in at least one usable alignment
+};
+
+PairGraph alignPairs(const std::vector<std::pair<int, int>>& pairs,
+                     const std::vector<std::unique_ptr<PreparedMember>>& members,
+                     const std::vector<Eigen::Isometry3d>& input, int reference, const Freedom& freedom,
+                     const RefinementParameters& parameters, RefinementReport& report) {
+  PairGraph graph;
+  graph.neighbours.resize(members.size());
+  graph.aligned.assign(members.size(), false);
+  graph.aligned[reference] = true;
+  for (const auto& [a, b] : pairs) {
+    ++report.pairs;
+    graph.neighbours[a].push_back(b);
+    graph.neighbours[b].push_back(a);
+    const PairAlignment pair = alignPair(*members[b], *members[a], input[a].inverse() * input[b], freedom, parameters);
+    if (!pair.usable) {
+      ++report.pairs_refused;
+      continue;
+    }
+    if (pair.partial) ++report.pairs_partial;
+    graph.aligned[a] = graph.aligned[b] = true;
+    graph.edges.push_back({a, b, pair.pose, pair.information, pair.floor, pair.radius, input[a] * pair.centre});
+  }
+  return graph;
+}
+
+enum class Outcome { Moved, NotBetter, BeyondBound, Unaligned };
+
+/// Which members keep their refined pose: those within the bounds whose
+/// points the refined map puts better on their neighbours' surfaces; the
+/// others are put back to `input` in `refined`. A second pass rechecks the
+/// rest once the first reverts are in.
+std::vector<Outcome> keepWhatHelps(const std::vector<Eigen::Isometry3d>& input, std::vector<Eigen::Isometry3d>& refined,
+                                   int reference, const PairGraph& graph,
+                                   const std::vector<std::unique_ptr<PreparedMember>>& members,
+                                   const Freedom& freedom, const RefinementParameters& parameters) {
+  const int m = static_cast<int>(input.size());
+  std::vector<Outcome> outcome(m, Outcome::Moved);
+  for (int k = 0; k < m; ++k) {
+    if (k == reference) continue;
+    const Eigen::Isometry3d correction = input[k].inverse() * refined[k];
+    if (!graph.aligned[k]) outcome[k] = Outcome::Unaligned;
+    else if (!refined[k].matrix().allFinite() ||
+             correction.translation().norm() > parameters.max_translation_correction ||
+             rotationAngle(correction) > parameters.max_rotation_correction)
+      outcome[k] = Outcome::BeyondBound;
+    if (outcome[k] != Outcome::Moved) refined[k] = input[k];
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> revert;
+    for (int k = 0; k < m; ++k) {
+      if (k == reference || outcome[k] != Outcome::Moved) continue;
+      const double before = consistency(k, graph.neighbours[k], members, input, freedom, parameters);
+      const double after = consistency(k, graph.neighbours[k], members, refined, freedom, parameters);
+      if (!(after > before * (1 + parameters.min_gain))) revert.push_back(k);
+    }
+    for (int k : revert) {
+      outcome[k] = Outcome::NotBetter;
+      refined[k] = input[k];
+    }
+    if (revert.empty()) break;
+  }
+  return outcome;
+}
+
+}  // namespace
+
 RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
                                    const std::vector<std::pair<int, int>>& pairs, bool planar,
                                    const RefinementParameters& parameters, LocalMapFrame& frame) {
@@ -592,62 +666,15 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   // Poses in one horizontal plane (a ground robot, whatever its sensor) are
   // refined in SE(2); the points decide only how normals are fitted.
   const Freedom freedom(posesArePlanar(frame.member_poses));
-
   std::vector<std::unique_ptr<PreparedMember>> members;
   members.reserve(m);
   const double voxel = planar ? parameters.alignment_voxel : parameters.alignment_voxel_3d;
   for (const auto& p : points) members.push_back(prepare(p, voxel, planar));
 
   const std::vector<Eigen::Isometry3d> input = frame.member_poses;
-  std::vector<GraphEdge> edges;
-  std::vector<std::vector<int>> neighbours(m);
-  std::vector<bool> aligned(m, false);
-  aligned[reference] = true;
-  for (const auto& [a, b] : pairs) {
-    ++report.pairs;
-    neighbours[a].push_back(b);
-    neighbours[b].push_back(a);
-    const PairAlignment pair =
-        alignPair(*members[b], *members[a], input[a].inverse() * input[b], freedom, parameters);
-    if (!pair.usable) {
-      ++report.pairs_refused;
-      continue;
-    }
-    if (pair.partial) ++report.pairs_partial;
-    aligned[a] = aligned[b] = true;
-    edges.push_back({a, b, pair.pose, pair.information, pair.floor, pair.radius, input[a] * pair.centre});
-  }
-  std::vector<Eigen::Isometry3d> refined = solvePoseGraph(input, reference, edges, freedom, parameters);
-
-  // A member keeps its refined pose only if the correction is within its
-  // bounds and the refined map puts more of its points on its neighbours'
-  // surfaces; a second pass rechecks the rest once the first reverts are in.
-  enum class Outcome { Moved, NotBetter, BeyondBound, Unaligned };
-  std::vector<Outcome> outcome(m, Outcome::Moved);
-  for (int k = 0; k < m; ++k) {
-    if (k == reference) continue;
-    const Eigen::Isometry3d correction = input[k].inverse() * refined[k];
-    if (!aligned[k]) outcome[k] = Outcome::Unaligned;
-    else if (!refined[k].matrix().allFinite() ||
-             correction.translation().norm() > parameters.max_translation_correction ||
-             rotationAngle(correction) > parameters.max_rotation_correction)
-      outcome[k] = Outcome::BeyondBound;
-    if (outcome[k] != Outcome::Moved) refined[k] = input[k];
-  }
-  for (int pass = 0; pass < 2; ++pass) {
-    std::vector<int> revert;
-    for (int k = 0; k < m; ++k) {
-      if (k == reference || outcome[k] != Outcome::Moved) continue;
-      const double before = consistency(k, neighbours[k], members, input, freedom, parameters);
-      const double after = consistency(k, neighbours[k], members, refined, freedom, parameters);
-      if (!(after > before * (1 + parameters.min_gain))) revert.push_back(k);
-    }
-    for (int k : revert) {
-      outcome[k] = Outcome::NotBetter;
-      refined[k] = input[k];
-    }
-    if (revert.empty()) break;
-  }
+  const PairGraph graph = alignPairs(pairs, members, input, reference, freedom, parameters, report);
+  std::vector<Eigen::Isometry3d> refined = solvePoseGraph(input, reference, graph.edges, freedom, parameters);
+  const std::vector<Outcome> outcome = keepWhatHelps(input, refined, reference, graph, members, freedom, parameters);
   for (int k = 0; k < m; ++k) {
     if (k == reference) continue;
     switch (outcome[k]) {
