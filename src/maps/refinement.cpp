@@ -375,8 +375,9 @@ PairAlignment alignPair(const PreparedMember& source, const PreparedMember& targ
   };
   // A wide first gate reaches larger errors but, on a small one, lets far
   // surfaces pull the pose into another basin (seen with depth cameras:
-  // 3 cm off became 30 cm off). Both are tried, and the guess itself: the
-  // pose that puts most points on the target's surface wins.
+  // 3 cm off became 30 cm off). Both are tried (the wide one only when the
+  // narrow one had something to correct), and the guess itself: the pose
+  // that puts most points on the target's surface wins.
   pose = guess;
   double best_score = accumulate(final_gate, H, gradient, squares, inliers) < 6 ? -1.0 : score;
   Eigen::Isometry3d best = guess;
@@ -386,6 +387,13 @@ PairAlignment alignPair(const PreparedMember& source, const PreparedMember& targ
       best_score = s;
       best = pose;
     }
+    // The narrow start stayed where the guess put it and found the target's
+    // surface there: the guess was right (exact poses), and the wide start,
+    // for errors the narrow one cannot reach, would only cost time.
+    const Eigen::Isometry3d moved = guess.inverse() * pose;
+    if (s >= 0 && inliers >= parameters.min_overlap * double(points.size()) && moved.translation().norm() < 1e-3 &&
+        rotationAngle(moved) < 1e-4)
+      break;
   }
   if (best_score < 0) return result;
   pose = best;
