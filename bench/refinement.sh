@@ -5,12 +5,16 @@
 # stage (where refinement runs) and the whole run: median seconds and peak RSS.
 # The target: refinement of 10,000 2D scans in at most 30 s on 2 cores.
 #
-#   bench/refinement.sh [N]      (N scans, default 10000)
+#   bench/refinement.sh [--output docs/performance.md] [N]   (N scans, default 10000)
 #
+# With --output the table replaces the lines between "<!-- refinement:begin -->"
+# and "<!-- refinement:end -->" of that file.
 # Needs /usr/bin/time (Debian package `time`). Inputs are generated under
 # ${OBSGROUP_BENCH_DIR:-/tmp/obsgroup-bench} and reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+output=""
+if [ "${1:-}" = --output ]; then output=$2; shift 2; fi
 n=${1:-10000}
 work=${OBSGROUP_BENCH_DIR:-${TMPDIR:-/tmp}/obsgroup-bench}
 mkdir -p "$work"
@@ -19,6 +23,8 @@ cmake --build build -j"$(nproc)" --target obsgroup_cli make_scaling_input > /dev
 cp build/obsgroup "$work/obsgroup-refine"  # a rebuild during the run cannot mix two versions
 input=$work/scaling_2d_$n.clf
 [ -f "$input" ] || build/bench/make_scaling_input 2d "$n" "$input" > /dev/null
+table=$(mktemp)
+{
 echo "Machine: $(nproc) cores; $(date -u +%Y-%m-%d); commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)."
 echo
 echo "| refinement | N | groups | members moved | local maps s, median of 3 | whole run s, median of 3 | peak RSS MiB |"
@@ -41,3 +47,17 @@ print(f"| {refine} | {n:,} | {s['groups']:,} | {s.get('refined_members', 0):,} |
       f"{statistics.median(walls):.2f} | {max(rss):,.0f} |")
 PY
 done
+} > "$table"
+if [ -z "$output" ]; then
+  cat "$table"
+else
+  python3 - "$output" "$table" <<'PY'
+import sys
+path, table = sys.argv[1], open(sys.argv[2]).read()
+text = open(path).read()
+begin, end = "<!-- refinement:begin -->", "<!-- refinement:end -->"
+b, e = text.index(begin), text.index(end)
+open(path, "w").write(text[: b + len(begin)] + "\n" + table + text[e:])
+PY
+fi
+rm -f "$table"
