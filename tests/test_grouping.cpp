@@ -79,8 +79,32 @@ TEST(ObservationGrouping, WeightMatrixHasTheConfiguredDiagonal) {
   EXPECT_TRUE(g.compute().groups.empty());
 }
 
-TEST(ObservationGrouping, RejectsNullClouds) {
+TEST(ObservationGrouping, RejectsNullCloudsNamingTheirIndex) {
   ObservationGrouping<pcl::PointXYZ> g;
-  EXPECT_THROW(g.addObservation(nullptr), std::invalid_argument);
-  EXPECT_THROW(g.addObservation(nullptr, Eigen::Isometry3d::Identity()), std::invalid_argument);
+  g.addObservation(pcl::PointCloud<pcl::PointXYZ>::ConstPtr(new pcl::PointCloud<pcl::PointXYZ>),
+                   Eigen::Isometry3d::Identity());
+  for (int overload = 0; overload < 2; ++overload) {
+    try {
+      if (overload == 0) g.addObservation(nullptr);
+      else g.addObservation(nullptr, Eigen::Isometry3d::Identity());
+      FAIL() << "a null cloud was accepted";
+    } catch (const InvalidObservation& e) {
+      EXPECT_EQ(e.index(), 1);  // the position it would have had
+      EXPECT_NE(std::string(e.what()).find("null cloud"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(g.getObservations().size(), 1u);
+}
+
+TEST(ObservationGrouping, PartitionOptionsSetLaterKeepTheThreadsAndTheInterruptFlag) {
+  ObservationGrouping<pcl::PointXYZ> g;
+  InterruptFlag flag{false};
+  g.setNumberOfThreads(1);
+  g.setInterruptFlag(&flag);
+  PartitionOptions options;
+  options.ncut_threshold = 0.5;
+  g.setPartitionOptions(options);
+  EXPECT_EQ(g.getPartitionOptions().threads, 1);
+  EXPECT_EQ(g.getPartitionOptions().interrupt, &flag);
+  EXPECT_EQ(g.getNcutThreshold(), 0.5);
 }

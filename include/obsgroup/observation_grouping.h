@@ -112,7 +112,17 @@ class ObservationGrouping {
   int getMaxDepth() const { return options_.max_depth; }
   void setEigenSolver(EigenSolver solver) { options_.eigen.solver = solver; }
   EigenSolver getEigenSolver() const { return options_.eigen.solver; }
-  void setPartitionOptions(const PartitionOptions& options) { options_ = options; }
+  /// All partition options at once. The thread count and the interrupt flag
+  /// are the ones setNumberOfThreads and setInterruptFlag gave (for the
+  /// overlap and the partition alike): those of `options` are ignored, so
+  /// that setting the options later does not undo them.
+  void setPartitionOptions(const PartitionOptions& options) {
+    const int threads = options_.threads;
+    const InterruptFlag* interrupt = options_.interrupt;
+    options_ = options;
+    options_.threads = threads;
+    options_.interrupt = interrupt;
+  }
   const PartitionOptions& getPartitionOptions() const { return options_; }
 
   /// Computes the overlap, builds W and partitions it. Throws

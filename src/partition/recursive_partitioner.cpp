@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <omp.h>
+#include <exception>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -92,7 +93,9 @@ class Partitioner {
     while (!frontier.empty()) {
       throwIfInterrupted(options_.interrupt);
       std::vector<Decision> decisions(frontier.size());
-      std::vector<std::string> errors(frontier.size());
+      // An exception must not leave the OpenMP region: each is kept and the
+      // one of the first node rethrown unchanged (an input error stays one).
+      std::vector<std::exception_ptr> errors(frontier.size());
 #pragma omp parallel num_threads(threads)
       {
         std::vector<int> local_of(n, -1);  // per-thread scratch of inducedSubgraph
@@ -100,13 +103,13 @@ class Partitioner {
         for (std::size_t k = 0; k < frontier.size(); ++k) {
           try {
             decisions[k] = decide(out_.splits[frontier[k]], local_of);
-          } catch (const std::exception& e) {
-            errors[k] = e.what();
+          } catch (...) {
+            errors[k] = std::current_exception();
           }
         }
       }
       for (const auto& e : errors)
-        if (!e.empty()) throw std::runtime_error(e);
+        if (e) std::rethrow_exception(e);
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "obsgroup/invalid_observation.h"
 #include "obsgroup/observation_grouping.h"
 
 #include <chrono>
@@ -9,13 +10,13 @@ namespace obsgroup {
 
 template <typename PointT>
 void ObservationGrouping<PointT>::addObservation(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose) {
-  if (!cloud) throw std::invalid_argument("ObservationGrouping::addObservation: null cloud");
+  if (!cloud) throw InvalidObservation(static_cast<int>(observations_.size()), "null cloud");
   observations_.push_back({cloud, pose});
 }
 
 template <typename PointT>
 void ObservationGrouping<PointT>::addObservation(const PointCloudConstPtr& cloud) {
-  if (!cloud) throw std::invalid_argument("ObservationGrouping::addObservation: null cloud");
+  if (!cloud) throw InvalidObservation(static_cast<int>(observations_.size()), "null cloud");
   addObservation(cloud, poseFromSensorOrigin(*cloud));
 }
 
