@@ -18,6 +18,7 @@
 // Run with --help for the parameters and the selection of datasets.
 
 #include "floor_plan.h"
+#include "generated_section.h"
 #include "scenarios.h"
 #include "to_cloud.h"
 
@@ -41,6 +42,8 @@
 #include <vector>
 
 using namespace obsgroup;
+using obsgroup::examples::splitList;
+using obsgroup::examples::writeGeneratedSection;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace {
@@ -378,22 +381,6 @@ std::string page(const std::vector<Dataset>& datasets, const std::vector<Configu
   return out.str();
 }
 
-int writeGeneratedSection(const std::string& file, const std::string& report) {
-  std::ifstream in(file);
-  std::stringstream existing;
-  existing << in.rdbuf();
-  const std::string text = existing.str();
-  const std::string begin = "<!-- generated:begin -->\n", end = "<!-- generated:end -->";
-  const std::size_t b = text.find(begin), e = text.find(end);
-  if (b == std::string::npos || e == std::string::npos || e < b) {
-    std::cerr << "error: " << file << ": no '<!-- generated:begin -->' ... '<!-- generated:end -->' section\n";
-    return 3;
-  }
-  std::ofstream(file) << text.substr(0, b + begin.size()) << report << text.substr(e);
-  std::cout << "updated " << file << "\n";
-  return 0;
-}
-
 /// The whole of `text` as a number; a trailing "abc" is an error, not ignored.
 double parseNumber(const std::string& flag, const std::string& text) {
   std::size_t used = 0;
@@ -412,14 +399,6 @@ int parseInteger(const std::string& flag, const std::string& text) {
   if (!(std::abs(value) < 1e9) || value != static_cast<int>(value))
     throw std::invalid_argument("bad integer for " + flag + ": '" + text + "'");
   return static_cast<int>(value);
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) items.push_back(item);
-  return items;
 }
 
 const char* kUsage =

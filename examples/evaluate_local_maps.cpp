@@ -14,6 +14,7 @@
 // "<!-- generated:end -->", keeping the rest.
 
 #include "floor_plan.h"
+#include "generated_section.h"
 #include "scenarios.h"
 #include "to_cloud.h"
 
@@ -41,6 +42,8 @@
 #include <thread>
 
 using namespace obsgroup;
+using obsgroup::examples::splitList;
+using obsgroup::examples::writeGeneratedSection;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 using Maps = std::vector<LocalMap<pcl::PointXYZ>>;
 
@@ -567,29 +570,6 @@ std::string evaluateAll(const std::vector<std::string>& keys, const std::vector<
   return report;
 }
 
-int writeBetweenMarkers(const std::string& path, const std::string& report) {
-  std::ifstream in(path);
-  std::stringstream existing;
-  existing << in.rdbuf();
-  const std::string text = existing.str();
-  const std::string begin = "<!-- generated:begin -->\n", end = "<!-- generated:end -->";
-  const std::size_t b = text.find(begin), e = text.find(end);
-  if (b == std::string::npos || e == std::string::npos || e < b) {
-    std::cerr << "error: " << path << ": no '<!-- generated:begin -->' ... '<!-- generated:end -->' section\n";
-    return 3;
-  }
-  std::ofstream(path) << text.substr(0, b + begin.size()) << report << text.substr(e);
-  std::cout << "updated " << path << "\n";
-  return 0;
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) items.push_back(item);
-  return items;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -625,5 +605,5 @@ int main(int argc, char** argv) {
     std::cout << report;
     return 0;
   }
-  return writeBetweenMarkers(output, report);
+  return writeGeneratedSection(output, report);
 }

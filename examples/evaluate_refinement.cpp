@@ -12,6 +12,7 @@
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
 
 #include "floor_plan.h"
+#include "generated_section.h"
 #include "scenarios.h"
 #include "to_cloud.h"
 
@@ -29,6 +30,8 @@
 #include <sstream>
 
 using namespace obsgroup;
+using obsgroup::examples::splitList;
+using obsgroup::examples::writeGeneratedSection;
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 namespace {
@@ -147,14 +150,6 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted) {
   return out.str();
 }
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> items;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) items.push_back(item);
-  return items;
-}
-
 const char* kHeader =
     "| dataset | maps | refinement | error median / p90 (cm) | rotation median / p90 (deg) | members moved | maps "
     "with a warning | z, roll, pitch unchanged | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
@@ -169,10 +164,10 @@ int main(int argc, char** argv) {
   for (int a = 1; a + 1 < argc; a += 2) {
     const std::string option = argv[a];
     if (option == "--output") output = argv[a + 1];
-    else if (option == "--buildings") buildings = split(argv[a + 1]);
+    else if (option == "--buildings") buildings = splitList(argv[a + 1]);
     else if (option == "--sensors") {
       sensors.clear();
-      for (const auto& s : split(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
+      for (const auto& s : splitList(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
     } else {
       std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...]\n";
       return 2;
@@ -191,15 +186,5 @@ int main(int argc, char** argv) {
     std::cout << page.str();
     return 0;
   }
-  std::ifstream in(output);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string all = text.str(), begin = "<!-- generated:begin -->", end = "<!-- generated:end -->";
-  const auto b = all.find(begin), e = all.find(end);
-  if (b == std::string::npos || e == std::string::npos || e < b) {
-    std::cerr << output << ": no generated:begin/end markers\n";
-    return 1;
-  }
-  std::ofstream(output) << all.substr(0, b + begin.size()) << "\n" << page.str() << all.substr(e);
-  return 0;
+  return writeGeneratedSection(output, page.str());
 }
