@@ -1,5 +1,6 @@
 #include "obsgroup/overlap/sensed_regions.h"
 
+#include "obsgroup/common/parallel_for.h"
 #include "obsgroup/invalid_observation.h"
 
 #include <omp.h>
@@ -36,25 +37,6 @@ SensedSpaceModel sensedSpaceModelFromString(const std::string& name) {
 }
 
 namespace {
-
-int threadCount(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
-
-/// Keeps the first exception of a parallel loop by index and rethrows it
-/// after the region, so that errors do not depend on the thread count.
-class FirstError {
- public:
-  void keep(long index, std::exception_ptr e) {
-#pragma omp critical(obsgroup_regions_error)
-    if (!error_ || index < index_) error_ = e, index_ = index;
-  }
-  void rethrow() const {
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  std::exception_ptr error_;
-  long index_ = std::numeric_limits<long>::max();
-};
 
 // --- cells and keys ---------------------------------------------------------
 //
@@ -553,30 +535,24 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   const OccupancyGrid grid(occupied);
   std::vector<std::vector<std::uint64_t>>& per_observation = regions.cells;
   per_observation.resize(n);
-  FirstError error;
-#pragma omp parallel num_threads(threads)
-  {
+  struct Scratch {
     RegionMarker<2> marker2, own_surfaces;
     RegionMarker<3> marker3;
-    OccupancyGrid::Reader reader(grid);
-#pragma omp for schedule(dynamic, 8)
-    for (int i = 0; i < n; ++i) {
-      if (interruptRequested(interrupt)) continue;
-      try {
+    OccupancyGrid::Reader reader;
+  };
+  parallelForWithScratch(
+      n, threads, 8, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(grid)}; },
+      [&](std::size_t i, Scratch& s) {
+        if (interruptRequested(interrupt)) return;
         if (model == SensedSpaceModel::Visibility)
-          visibilityOf(world, i, sensor_origins[i], params, cells, regions.planar, reader, own_surfaces, marker2,
-                       per_observation[i]);
+          visibilityOf(world, static_cast<int>(i), sensor_origins[i], params, cells, regions.planar, s.reader,
+                       s.own_surfaces, s.marker2, per_observation[i]);
         else if (volumetric)
-          freeSpaceOf<3>(world, i, sensor_origins[i], params, cells, marker3, per_observation[i]);
+          freeSpaceOf<3>(world, static_cast<int>(i), sensor_origins[i], params, cells, s.marker3, per_observation[i]);
         else
-          freeSpaceOf<2>(world, i, sensor_origins[i], params, cells, marker2, per_observation[i]);
-      } catch (...) {
-        error.keep(i, std::current_exception());
-      }
-    }
-  }
+          freeSpaceOf<2>(world, static_cast<int>(i), sensor_origins[i], params, cells, s.marker2, per_observation[i]);
+      });
   throwIfInterrupted(interrupt);
-  error.rethrow();
   regions.planar = !volumetric;
   return regions;
 }

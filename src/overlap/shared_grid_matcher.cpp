@@ -1,5 +1,6 @@
 #include "obsgroup/overlap/shared_grid_matcher.h"
 
+#include "obsgroup/common/parallel_for.h"
 #include "obsgroup/invalid_observation.h"
 
 #include <omp.h>
@@ -147,22 +148,14 @@ class Grid {
       throw std::invalid_argument("shared grid: more than 4 billion points");
     std::vector<Entry> entries(total);
     const int n = world_.size();
-    int first_bad = n;  // the lowest failing observation is reported, whatever the threads
-    std::string why;
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 64)
-    for (int i = 0; i < n; ++i) {
+    parallelFor(n, threads_, 64, [&](std::size_t i) {
       try {
         for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
           entries[k] = Entry{cellOf(world_.points[k]), static_cast<std::uint32_t>(k)};
       } catch (const std::invalid_argument& e) {
-#pragma omp critical(obsgroup_grid_error)
-        if (i < first_bad) {
-          first_bad = i;
-          why = e.what();
-        }
+        throw InvalidObservation(static_cast<int>(i), e.what());
       }
-    }
-    if (first_bad < n) throw InvalidObservation(first_bad, why);
+    });
     return entries;
   }
 

@@ -1,11 +1,11 @@
 #include "obsgroup/partition/recursive_partitioner.h"
 
+#include "obsgroup/common/parallel_for.h"
+
 #include <Eigen/OrderingMethods>
 
 #include <algorithm>
 #include <cmath>
-#include <omp.h>
-#include <exception>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -89,27 +89,14 @@ class Partitioner {
     // parallel, then their children are numbered in level order, exactly as a
     // FIFO would: the output is the same for any thread count, and deep
     // recursions cannot overflow the stack.
-    const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
     while (!frontier.empty()) {
       throwIfInterrupted(options_.interrupt);
       std::vector<Decision> decisions(frontier.size());
-      // An exception must not leave the OpenMP region: each is kept and the
-      // one of the first node rethrown unchanged (an input error stays one).
-      std::vector<std::exception_ptr> errors(frontier.size());
-#pragma omp parallel num_threads(threads)
-      {
-        std::vector<int> local_of(n, -1);  // per-thread scratch of inducedSubgraph
-#pragma omp for schedule(dynamic, 1)
-        for (std::size_t k = 0; k < frontier.size(); ++k) {
-          try {
-            decisions[k] = decide(out_.splits[frontier[k]], local_of);
-          } catch (...) {
-            errors[k] = std::current_exception();
-          }
-        }
-      }
-      for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
+      // Each thread has its own scratch for inducedSubgraph; the first failing
+      // node's exception is rethrown unchanged (an input error stays one).
+      parallelForWithScratch(
+          frontier.size(), options_.threads, 1, [n] { return std::vector<int>(n, -1); },
+          [&](std::size_t k, std::vector<int>& local_of) { decisions[k] = decide(out_.splits[frontier[k]], local_of); });
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];

@@ -1,8 +1,9 @@
 // Links against an installed obsgroup: two overlapping line scans and one
-// far away give two groups.
+// far away give two groups, each coloured with PCL's visualization module.
 #include <obsgroup/observation_grouping.h>
 
 #include <pcl/point_types.h>
+#include <pcl/visualization/point_cloud_color_handlers.h>
 
 #include <cstdio>
 
@@ -14,6 +15,8 @@ int main() {
   grouping.addObservation(line, obsgroup::pose2D(0.5, 0, 0));
   grouping.addObservation(line, obsgroup::pose2D(0, 50, 0));
   const auto partition = grouping.compute();
-  std::printf("package consumer: %zu groups\n", partition.groups.size());
-  return partition.groups.size() == 2 ? 0 : 1;
+  pcl::visualization::PointCloudColorHandlerCustom<pcl::PointXYZ> colour(line, 255, 0, 0);
+  std::printf("package consumer: %zu groups, colour handler %s\n", partition.groups.size(),
+              colour.getName().c_str());
+  return partition.groups.size() == 2 && colour.isCapable() ? 0 : 1;
 }

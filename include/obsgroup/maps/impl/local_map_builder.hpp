@@ -176,8 +176,7 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
                                                              const Partition& partition, const WeightMatrix& W) const {
   std::vector<LocalMap<PointT>> maps(partition.groups.size());
   const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
-  const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
-  parallelFor(partition.groups.size(), threads, [&](std::size_t g) {
+  parallelFor(partition.groups.size(), threads_, [&](std::size_t g) {
     if (interruptRequested(interrupt_)) return;
     const std::string name = "local map " + std::to_string(g) + ": ";
     try {

@@ -2,6 +2,7 @@
 
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/overlap/shared_grid_matcher.h"
+#include "obsgroup/common/parallel_for.h"
 
 #include <pcl/common/common.h>
 #include <pcl/filters/voxel_grid.h>
@@ -72,18 +73,14 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
     world.origin = observations[0].pose.translation();
 
   std::vector<std::vector<Eigen::Vector3f>> per_observation(n);
-  std::vector<std::string> errors(n);
-  const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
-  for (int i = 0; i < n; ++i) {
+  const int threads = threadCount(threads_);
+  parallelFor(n, threads, 4, [&](std::size_t i) {
     try {
       per_observation[i] = observationToWorld(observations[i], world.origin);
     } catch (const std::exception& e) {
-      errors[i] = e.what();
+      throw InvalidObservation(static_cast<int>(i), e.what());
     }
-  }
-  for (int i = 0; i < n; ++i)
-    if (!errors[i].empty()) throw InvalidObservation(i, errors[i]);
+  });
   world.appendAll(per_observation, threads);
   return world;
 }
@@ -146,7 +143,7 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
   std::atomic<std::size_t> done{0};
   // A user's search object is shared, so it runs on one thread; otherwise
   // each thread owns a kd-tree.
-  const int threads = search_ ? 1 : (threads_ > 0 ? threads_ : omp_get_max_threads());
+  const int threads = search_ ? 1 : (threadCount(threads_));
 #pragma omp parallel num_threads(threads) reduction(+ : pairs, tests)
   {
     SearchMethodPtr search = search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false));
