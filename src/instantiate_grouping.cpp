@@ -1,5 +1,7 @@
 // Explicit instantiations of ObservationGrouping for the common point types.
 #include "obsgroup/impl/observation_grouping.hpp"
-#include "obsgroup/point_types.h"
+#include "obsgroup/cloud/point_types.h"
 
-OBSGROUP_FOR_EACH_POINT_TYPE(OBSGROUP_INSTANTIATE_ObservationGrouping)
+#include <pcl/impl/instantiate.hpp>
+
+PCL_INSTANTIATE(ObservationGrouping, OBSGROUP_POINT_TYPES)

@@ -5,7 +5,7 @@
 #include "floor_plan.h"
 #include "to_cloud.h"
 
-#include <obsgroup/observation.h>
+#include <obsgroup/cloud/observation.h>
 
 #include <pcl/io/pcd_io.h>
 

@@ -4,7 +4,7 @@
 /// class. Observations in, groups (future local maps) out.
 
 #include "obsgroup/graph/observation_graph.h"
-#include "obsgroup/observation.h"
+#include "obsgroup/cloud/observation.h"
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 

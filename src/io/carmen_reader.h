@@ -2,7 +2,7 @@
 // Reader of CARMEN logs (.clf, .log, GMapping's .gfs.log): FLASER, RLASER
 // and ROBOTLASER1 messages.
 
-#include <obsgroup/observation.h>
+#include <obsgroup/cloud/observation.h>
 
 #include <pcl/point_types.h>
 

@@ -6,7 +6,7 @@
 // none, never a mix. Results are never replaced without --force, and a
 // folder holding files obsgroup did not write is never replaced at all.
 
-#include <obsgroup/interrupt.h>
+#include <obsgroup/common/interrupt.h>
 
 #include <functional>
 #include <string>

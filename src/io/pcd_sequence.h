@@ -4,7 +4,7 @@
 
 #include "pose_file.h"
 
-#include <obsgroup/observation.h>
+#include <obsgroup/cloud/observation.h>
 
 #include <optional>
 #include <string>

@@ -200,8 +200,8 @@ bool residual(const PreparedMember& target, const Eigen::Vector3d& x, const Eige
               double gate, double& r, Eigen::Vector3d& normal, flann::KNNSimpleResultSet<float>& nearest) {
   if (!target.index) return false;
   target.nearest(x.cast<float>(), nearest);
-  std::size_t index;
-  float distance;
+  std::size_t index = 0;
+  float distance = std::numeric_limits<float>::infinity();
   nearest.copy(&index, &distance, 1);
   if (!(distance <= gate * gate)) return false;
   normal = target.normals[index];

@@ -1,7 +1,7 @@
 #include "obsgroup/overlap/shared_grid_matcher.h"
 
 #include "obsgroup/common/parallel_for.h"
-#include "obsgroup/invalid_observation.h"
+#include "obsgroup/common/invalid_observation.h"
 
 #include <omp.h>
 

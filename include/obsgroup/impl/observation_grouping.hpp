@@ -1,6 +1,6 @@
 #pragma once
 
-#include "obsgroup/invalid_observation.h"
+#include "obsgroup/common/invalid_observation.h"
 #include "obsgroup/observation_grouping.h"
 
 #include <chrono>
@@ -56,4 +56,4 @@ Partition ObservationGrouping<PointT>::compute() {
 
 }  // namespace obsgroup
 
-#define OBSGROUP_INSTANTIATE_ObservationGrouping(T) template class obsgroup::ObservationGrouping<T>;
+#define PCL_INSTANTIATE_ObservationGrouping(T) template class obsgroup::ObservationGrouping<T>;

@@ -4,10 +4,10 @@
 /// step 3): the group's observations relative to a reference observation,
 /// optionally refined by scan alignment (refinement.h), merged into one cloud.
 
-#include "obsgroup/interrupt.h"
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/maps/refinement.h"
 #include "obsgroup/maps/topological_map.h"
-#include "obsgroup/observation.h"
+#include "obsgroup/cloud/observation.h"
 
 #include <memory>
 #include <string>

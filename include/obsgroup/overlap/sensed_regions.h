@@ -17,7 +17,7 @@
 ///    other way in the same room still overlaps.
 /// With either, Pi(i, j) = |R_i and R_j| / |R_i| and Psi is eq. (18) as before.
 
-#include "obsgroup/interrupt.h"
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 #include "obsgroup/overlap/world_points.h"
 

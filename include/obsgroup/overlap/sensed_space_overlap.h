@@ -3,8 +3,8 @@
 /// Sensed-space overlap (SSO) of paper sec. IV-A, eq. (16)-(18), for any PCL
 /// point type with x, y, z.
 
-#include "obsgroup/interrupt.h"
-#include "obsgroup/observation.h"
+#include "obsgroup/common/interrupt.h"
+#include "obsgroup/cloud/observation.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 #include "obsgroup/overlap/sensed_regions.h"
 #include "obsgroup/overlap/world_points.h"

@@ -4,7 +4,7 @@
 /// observation's world points, so the whole overlap matrix comes from one
 /// pass over the cells and one over the observations.
 
-#include "obsgroup/interrupt.h"
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 
 namespace obsgroup {

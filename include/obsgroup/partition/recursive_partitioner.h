@@ -4,7 +4,7 @@
 /// minimum normalized cut stays below a threshold.
 
 #include "obsgroup/graph/observation_graph.h"
-#include "obsgroup/interrupt.h"
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/spectral/spectral_bisection.h"
 
 #include <limits>

@@ -2,14 +2,12 @@
 
 #include "obsgroup/maps/local_map_builder.h"
 
+#include "obsgroup/cloud/finite_points.h"
 #include "obsgroup/common/parallel_for.h"
 
 #include <pcl/common/common.h>
 #include <pcl/common/transforms.h>
-#include <pcl/filters/filter.h>
 #include <pcl/filters/voxel_grid.h>
-
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -26,11 +24,8 @@ namespace detail {
 /// The finite points of a cloud, moved by `pose` (composed in double).
 template <typename PointT>
 typename pcl::PointCloud<PointT>::Ptr movedCloud(const pcl::PointCloud<PointT>& in, const Eigen::Isometry3d& pose) {
-  pcl::PointCloud<PointT> finite;
-  pcl::Indices kept;
-  pcl::removeNaNFromPointCloud(in, finite, kept);
   typename pcl::PointCloud<PointT>::Ptr out(new pcl::PointCloud<PointT>);
-  pcl::transformPointCloud(finite, *out, Eigen::Affine3d(pose.matrix()));
+  pcl::transformPointCloud<PointT, double>(finitePoints(in), *out, Eigen::Affine3d(pose.matrix()));
   return out;
 }
 
@@ -99,8 +94,7 @@ void LocalMapBuilder<PointT>::refine(const std::vector<Observation<PointT>>& obs
   const auto& members = frame.members;
   std::vector<MemberPoints> points(members.size());
   for (std::size_t k = 0; k < members.size(); ++k)
-    for (const PointT& p : observations[members[k]].cloud->points)
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) points[k].emplace_back(p.x, p.y, p.z);
+    for (const PointT& p : finitePoints(*observations[members[k]].cloud).points) points[k].emplace_back(p.x, p.y, p.z);
   // The spanning tree's pairs first (each member with the one it overlaps
   // most on the way from the reference); Lum adds every member's strongest
   // other overlaps, so that a pose graph with loops spreads the error.
@@ -195,4 +189,4 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
 
 }  // namespace obsgroup
 
-#define OBSGROUP_INSTANTIATE_LocalMapBuilder(T) template class obsgroup::LocalMapBuilder<T>;
+#define PCL_INSTANTIATE_LocalMapBuilder(T) template class obsgroup::LocalMapBuilder<T>;

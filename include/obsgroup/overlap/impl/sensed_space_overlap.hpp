@@ -4,7 +4,10 @@
 #include "obsgroup/overlap/shared_grid_matcher.h"
 #include "obsgroup/common/parallel_for.h"
 
+#include "obsgroup/cloud/finite_points.h"
+
 #include <pcl/common/common.h>
+#include <pcl/common/transforms.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/search/kdtree.h>
 
@@ -25,12 +28,7 @@ std::vector<Eigen::Vector3f> SensedSpaceOverlap<PointT>::observationToWorld(
   if (!observation.cloud) throw std::invalid_argument("observation has no cloud (null pointer)");
   if (!observation.pose.matrix().allFinite()) throw std::invalid_argument("observation pose is not finite");
 
-  // NaN/Inf points carry no sensed space; a cloud marked dense may still hold
-  // them, so every point is checked rather than trusting is_dense.
-  PointCloud finite;
-  finite.reserve(observation.cloud->size());
-  for (const PointT& p : observation.cloud->points)
-    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) finite.push_back(p);
+  const PointCloud finite = finitePoints(*observation.cloud);
 
   PointCloud filtered;
   const PointCloud* used = &finite;
@@ -54,12 +52,13 @@ std::vector<Eigen::Vector3f> SensedSpaceOverlap<PointT>::observationToWorld(
 
   // The pose is applied in double and the result re-centred before rounding
   // to float (see WorldPoints).
-  const Eigen::Matrix3d R = observation.pose.linear();
-  const Eigen::Vector3d t = observation.pose.translation() - origin;
+  Eigen::Affine3d to_world(observation.pose.matrix());
+  to_world.translation() -= origin;
+  PointCloud moved;
+  pcl::transformPointCloud<PointT, double>(*used, moved, to_world, false);
   std::vector<Eigen::Vector3f> out;
-  out.reserve(used->size());
-  for (const PointT& p : used->points)
-    out.push_back((R * Eigen::Vector3d(p.x, p.y, p.z) + t).template cast<float>());
+  out.reserve(moved.size());
+  for (const PointT& p : moved.points) out.emplace_back(p.x, p.y, p.z);
   return out;
 }
 
@@ -202,4 +201,4 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
 
 }  // namespace obsgroup
 
-#define OBSGROUP_INSTANTIATE_SensedSpaceOverlap(T) template class obsgroup::SensedSpaceOverlap<T>;
+#define PCL_INSTANTIATE_SensedSpaceOverlap(T) template class obsgroup::SensedSpaceOverlap<T>;

@@ -3,7 +3,7 @@
 /// An observation of the paper's eq. (14): the sensed data o_i (a PCL cloud in
 /// the sensor frame) and the pose p_i it was taken from.
 
-#include "obsgroup/invalid_observation.h"
+#include "obsgroup/common/invalid_observation.h"
 
 #include <pcl/point_cloud.h>
 
