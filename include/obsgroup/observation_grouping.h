@@ -134,8 +134,15 @@ class ObservationGrouping {
   /// Pi, Psi and work statistics of the last compute().
   const OverlapResult& getOverlap() const { return overlap_result_; }
   /// The overlap stage as configured (model, voxel leaf, regions, threads),
-  /// e.g. to move the observations to the common frame again for a picture.
+  /// e.g. to compute the observations' regions for a picture.
   const SensedSpaceOverlap<PointT>& getSensedSpaceOverlap() const { return overlap_; }
+  /// Keep the observations' points in the common frame, as the overlap saw
+  /// them (filtered, at the input poses), after compute(): off by default,
+  /// as they are as large as the clouds.
+  void setKeepWorldPoints(bool keep) { keep_world_points_ = keep; }
+  bool getKeepWorldPoints() const { return keep_world_points_; }
+  /// The points kept by the last compute() (empty unless setKeepWorldPoints(true)).
+  const WorldPoints& getWorldPoints() const { return world_; }
   /// Time spent in each stage of the last compute().
   const GroupingTimings& getTimings() const { return timings_; }
   /// What the user should know about the last compute(), deterministic and
@@ -150,6 +157,8 @@ class ObservationGrouping {
   PartitionOptions options_;
   OverlapResult overlap_result_;
   WeightMatrix W_;
+  bool keep_world_points_ = false;
+  WorldPoints world_;
   GroupingTimings timings_;
   std::vector<std::string> warnings_;
 };

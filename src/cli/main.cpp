@@ -5,6 +5,7 @@
 // or SIGTERM: the output folder is left as it was), 1 anything else.
 
 #include "errors.h"
+#include "option_checks.h"
 #include "partition_command.h"
 
 #include <CLI/CLI.hpp>
@@ -13,7 +14,9 @@
 #include <signal.h>
 
 #include <cstdio>
-#include <map>
+#include <limits>
+#include <optional>
+#include <string>
 
 namespace {
 
@@ -33,109 +36,171 @@ void catchInterrupts() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
-void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, double& fov, double& max_range,
-                         std::string& poses, int& max_depth, double& map_voxel, std::vector<double>& band, bool& paper) {
-  using obsgroup::SplitCriterion;
-  using obsgroup::io::LaserSource;
-  using obsgroup::io::PoseFormat;
+void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  using namespace obsgroup;
+  using cli::choices;
+  using cli::finiteNumber;
+  using cli::oneOf;
+  using cli::wholeNumber;
   command.add_option("input", args.input, "CARMEN log (.clf, .log, .gfs.log) or folder of .pcd files")->required();
   command.add_option("-o,--output", args.output, "folder to write the results to")->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
-      ->check(CLI::IsMember({"auto", "carmen", "pcd"}));
+      ->check(CLI::IsMember({"auto", "carmen", "pcd"}))
+      ->option_text("auto|carmen|pcd");
 
-  const std::map<std::string, LaserSource> lasers{
-      {"front", LaserSource::Front}, {"rear", LaserSource::Rear}, {"robotlaser", LaserSource::RobotLaser}};
-  command.add_option("--laser", args.laser, "CARMEN: which laser messages (FLASER, RLASER, ROBOTLASER1)")
-      ->transform(CLI::CheckedTransformer(lasers))
+  command.add_option("--laser", args.laser, "CARMEN: which laser messages: FLASER, RLASER or ROBOTLASER1 (default: auto, "
+                                            "ROBOTLASER1 if any, else FLASER, else RLASER)")
+      ->transform(oneOf(io::kLaserSourceNames))
+      ->option_text(choices(io::kLaserSourceNames))
       ->group("CARMEN logs");
-  command.add_option("--fov", fov, "CARMEN: field of view of FLASER/RLASER scans, degrees (default: PARAM, else 180)")
-      ->check(CLI::Range(1.0, 360.0))
+  command.add_option("--fov", args.field_of_view_deg,
+                     "CARMEN: field of view of FLASER/RLASER scans, degrees (default: PARAM, else 180)")
+      ->check(finiteNumber(1.0, false, 360.0))
       ->group("CARMEN logs");
-  command.add_option("--max-range", max_range, "CARMEN: readings at or beyond this are no return, metres")
-      ->check(CLI::PositiveNumber)
+  command.add_option("--max-range", args.max_range,
+                     "CARMEN: readings at or beyond this are no return, metres (default: the message's, PARAM, "
+                     "else 80)")
+      ->check(finiteNumber(0.0, true))
       ->group("CARMEN logs");
 
-  command.add_option("--poses", poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
+  command.add_option("--poses", args.poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
       ->group("PCD sequences");
-  const std::map<std::string, PoseFormat> formats{{"tum", PoseFormat::Tum}, {"kitti", PoseFormat::Kitti}};
-  command.add_option("--pose-format", args.pose_format, "PCD: format of --poses")
-      ->transform(CLI::CheckedTransformer(formats))
+  command.add_option("--pose-format", args.pose_format, "PCD: format of --poses (default: tum)")
+      ->transform(oneOf(io::kPoseFormatNames))
+      ->option_text(choices(io::kPoseFormatNames))
       ->group("PCD sequences");
 
-  const std::map<std::string, obsgroup::SensedSpaceModel> models{
-      {"points", obsgroup::SensedSpaceModel::Points},
-      {"free-space", obsgroup::SensedSpaceModel::FreeSpace},
-      {"visibility", obsgroup::SensedSpaceModel::Visibility}};
   command.add_option("--sso", args.sso,
                      "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "
-                     "visibility (cells visible from the pose; the default)")
-      ->transform(CLI::CheckedTransformer(models))
+                     "visibility (cells visible from the pose) (default: " + toString(args.sso) + ")")
+      ->transform(oneOf(kSensedSpaceModelNames))
+      ->option_text(choices(kSensedSpaceModelNames))
       ->group("Method");
-  command.add_flag("--paper", paper,
+  command.add_flag("--paper", args.paper,
                    "the paper's method exactly: --sso points --split mean --ncut-threshold 1 (delta as given)")
       ->group("Method");
   command.add_option("--cell", args.region.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
-      ->check(CLI::PositiveNumber)
+      ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--range", args.region.max_range, "free-space, visibility: how far from the sensor, metres")
-      ->check(CLI::PositiveNumber)
+      ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--clearance", args.region.clearance,
                      "visibility: occupied cells nearer the pose than this do not block, metres")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finiteNumber(0.0))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--min-observations", args.region.min_observations,
                      "visibility: a cell is occupied when this many observations have a point in it (and no more "
-                 "saw through it)")
-      ->check(CLI::Range(1, 1 << 30))
+                     "saw through it)")
+      ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--band", band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
-                                     "LOW HIGH metres")
+  command.add_option("--band", args.band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
+                                          "LOW HIGH metres (default: " + std::to_string(args.region.band_low) + " " +
+                                          std::to_string(args.region.band_high) + ")")
       ->expected(2)
+      ->check(finiteNumber(-std::numeric_limits<double>::max()))
       ->group("Method");
   command.add_option("--delta", args.delta, "points: match distance of eq. (16), metres")
-      ->check(CLI::PositiveNumber)
+      ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--voxel", args.voxel, "voxel downsampling leaf before matching, metres (0 = off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(finiteNumber(0.0))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--ncut-threshold", args.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
-      ->check(CLI::Range(0.0, 2.0))
+      ->check(finiteNumber(0.0, false, 2.0))
       ->capture_default_str()
       ->group("Method");
-  const std::map<std::string, SplitCriterion> splits{
-      {"mean", SplitCriterion::Mean}, {"sign", SplitCriterion::Sign}, {"best", SplitCriterion::BestNcut}};
-  command.add_option("--split", args.split, "how the eigenvector is cut: best (smallest Ncut; the default), mean (the paper's) or sign")
-      ->transform(CLI::CheckedTransformer(splits))
+  command.add_option("--split", args.split,
+                     "how the eigenvector is cut: best (smallest Ncut), mean (the paper's) or sign (default: " +
+                         toString(args.split) + ")")
+      ->transform(oneOf(kSplitCriterionNames))
+      ->option_text(choices(kSplitCriterionNames))
       ->group("Method");
   command.add_option("--min-group-size", args.min_group_size, "reject a bisection giving a smaller group")
-      ->check(CLI::Range(1, 1 << 30))
+      ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--max-depth", max_depth, "do not bisect deeper than this (default: no limit)")
-      ->check(CLI::NonNegativeNumber)
+  command.add_option("--max-depth", args.max_depth, "do not bisect deeper than this (default: no limit)")
+      ->check(wholeNumber(0))
       ->group("Method");
   command.add_option("--threads", args.threads, "threads (0 = all cores); results do not depend on it")
-      ->check(CLI::NonNegativeNumber)
+      ->check(wholeNumber(0))
       ->capture_default_str();
-  const std::map<std::string, obsgroup::Refinement> refinements{{"none", obsgroup::Refinement::None},
-                                                                {"icp", obsgroup::Refinement::Icp},
-                                                                {"lum", obsgroup::Refinement::Lum}};
   command.add_option("--refine", args.refine,
-                     "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios)")
-      ->transform(CLI::CheckedTransformer(refinements));
-  command.add_option("--map-voxel", map_voxel, "voxel leaf of the local maps written, metres (default: delta/2)")
-      ->check(CLI::NonNegativeNumber);
+                     "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios) (default: " +
+                         toString(args.refine) + ")")
+      ->transform(oneOf(kRefinementNames))
+      ->option_text(choices(kRefinementNames));
+  command.add_option("--map-voxel", args.map_voxel,
+                     "voxel leaf of the local maps written, metres (0 = off; default: delta/2)")
+      ->check(finiteNumber(0.0));
   command.add_flag("--force", args.force, "replace the results already in the output folder");
   command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr");
-  command.add_flag("!--no-pictures", args.pictures,
+  command.add_flag("--no-pictures", args.no_pictures,
                    "do not draw map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png");
+}
+
+/// CLI11's messages with the command's prefix, and where to read more.
+std::string failureMessage(const CLI::App* app, const CLI::Error& e) {
+  std::string text = "obsgroup: error: " + std::string(e.what()) + "\n";
+  std::string path = app->get_name();
+  for (const CLI::App* command : app->get_subcommands()) path += " " + command->get_name();
+  return text + "Run '" + path + " --help' for the options.\n";
+}
+
+/// The command a user typed, checked before CLI11 parses: it only says "A
+/// subcommand is required" or that a misspelt one "was not expected".
+std::optional<std::string> commandError(int argc, char** argv, const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* command : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + command->get_name();
+  if (argc < 2) return "a command is required: " + names + " (obsgroup --help for more)";
+  const std::string first = argv[1];
+  if (first.empty() || first[0] == '-') return std::nullopt;  // --help, --version, or an error CLI11 words
+  for (const CLI::App* command : app.get_subcommands({}))
+    if (command->get_name() == first) return std::nullopt;
+  return "unknown command '" + first + "' (commands: " + names + ")";
+}
+
+/// The options that only make sense together, and the --paper preset.
+/// Returns the usage error, if any.
+std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cli::PartitionArgs& args) {
+  using obsgroup::SensedSpaceModel;
+  using obsgroup::SplitCriterion;
+  if (args.paper) {
+    if (partition.count("--sso") && args.sso != SensedSpaceModel::Points)
+      return "--paper uses --sso points; drop one of them";
+    if (partition.count("--split") && args.split != SplitCriterion::Mean)
+      return "--paper uses --split mean; drop one of them";
+    if (partition.count("--ncut-threshold") && args.ncut_threshold != 1.0)
+      return "--paper uses --ncut-threshold 1; drop one of them";
+    args.sso = SensedSpaceModel::Points;
+    args.split = SplitCriterion::Mean;
+    args.ncut_threshold = 1.0;
+  }
+  // Options of one model given with another are a mistake, not a no-op.
+  const bool points = args.sso == SensedSpaceModel::Points;
+  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})
+    if (points && partition.count(option))
+      return std::string(option) + " applies to --sso free-space or visibility, not points";
+  if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
+  if (args.sso == SensedSpaceModel::FreeSpace)
+    for (const char* option : {"--clearance", "--min-observations", "--band"})
+      if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
+  if (!args.band.empty()) {
+    if (!(args.band[0] < args.band[1]))
+      return "--band: LOW must be below HIGH (got " + std::to_string(args.band[0]) + " " +
+             std::to_string(args.band[1]) + ")";
+    args.region.band_low = args.band[0];
+    args.region.band_high = args.band[1];
+  }
+  args.pictures = !args.no_pictures;
+  return std::nullopt;
 }
 
 }  // namespace
@@ -143,18 +208,20 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
 int main(int argc, char** argv) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // obsgroup words its own errors
 
-  CLI::App app{"obsgroup: group robot observations into consistent local maps and a metric-topological map"};
+  CLI::App app{"obsgroup: group robot observations into consistent local maps and a metric-topological map",
+               "obsgroup"};
   app.set_version_flag("--version", "obsgroup 0.1.0");
   app.require_subcommand(1, 1);
+  app.failure_message(failureMessage);
   obsgroup::cli::PartitionArgs args;
-  double fov = 0.0, max_range = 0.0, map_voxel = 0.0;
-  std::string poses;
-  int max_depth = 0;
-  std::vector<double> band;
-  bool paper = false;
   CLI::App* partition = app.add_subcommand("partition", "group the observations of a log or a PCD sequence");
-  addPartitionOptions(*partition, args, fov, max_range, poses, max_depth, map_voxel, band, paper);
+  addPartitionOptions(*partition, args);
 
+  const auto usage = [](const std::string& message) {
+    std::fprintf(stderr, "obsgroup: error: %s\n", message.c_str());
+    return 2;
+  };
+  if (const auto error = commandError(argc, argv, app)) return usage(*error);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -163,44 +230,7 @@ int main(int argc, char** argv) {
     app.exit(e);
     return 2;
   }
-  if (partition->count("--fov")) args.field_of_view_deg = fov;
-  if (partition->count("--max-range")) args.max_range = max_range;
-  if (partition->count("--poses")) args.poses = poses;
-  if (partition->count("--max-depth")) args.max_depth = max_depth;
-  if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
-  // Options of one model given with another are a mistake, not a no-op.
-  const auto usage = [](const std::string& message) {
-    std::fprintf(stderr, "obsgroup: error: %s\n", message.c_str());
-    return 2;
-  };
-  if (paper) {
-    if (partition->count("--sso") && args.sso != obsgroup::SensedSpaceModel::Points)
-      return usage("--paper uses --sso points; drop one of them");
-    if (partition->count("--split") && args.split != obsgroup::SplitCriterion::Mean)
-      return usage("--paper uses --split mean; drop one of them");
-    if (partition->count("--ncut-threshold") && args.ncut_threshold != 1.0)
-      return usage("--paper uses --ncut-threshold 1; drop one of them");
-    args.sso = obsgroup::SensedSpaceModel::Points;
-    args.split = obsgroup::SplitCriterion::Mean;
-    args.ncut_threshold = 1.0;
-  }
-  const bool points = args.sso == obsgroup::SensedSpaceModel::Points;
-  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})
-    if (points && partition->count(option))
-      return usage(std::string(option) + " applies to --sso free-space or visibility, not points");
-  if (!points && partition->count("--delta"))
-    return usage("--delta applies to --sso points (the region models use --cell)");
-  if (args.sso == obsgroup::SensedSpaceModel::FreeSpace)
-    for (const char* option : {"--clearance", "--min-observations", "--band"})
-      if (partition->count(option)) return usage(std::string(option) + " applies to --sso visibility only");
-  if (partition->count("--band")) {
-    if (!(band[0] < band[1])) {
-      std::fprintf(stderr, "obsgroup: error: --band: LOW must be below HIGH (got %g %g)\n", band[0], band[1]);
-      return 2;
-    }
-    args.region.band_low = band[0];
-    args.region.band_high = band[1];
-  }
+  if (const auto error = settleOptions(*partition, args)) return usage(*error);
 
   args.interrupt = &interrupt_requested;
   catchInterrupts();
@@ -210,8 +240,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "\nobsgroup: interrupted; %s was left as it was\n", args.output.c_str());
     return 130;
   } catch (const obsgroup::io::UsageError& e) {
-    std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
-    return 2;
+    return usage(e.what());
   } catch (const obsgroup::io::InputError& e) {
     std::fprintf(stderr, "obsgroup: error: %s\n", e.what());
     return 3;

@@ -10,6 +10,7 @@
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/maps/topological_map.h>
+#include <obsgroup/common/parallel_for.h>
 #include <obsgroup/observation_grouping.h>
 
 #include <omp.h>
@@ -73,12 +74,19 @@ class Warnings {
 };
 
 template <typename PointT>
-int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
-  Warnings warn(args.quiet);
-  for (const auto& w : input.warnings) warn(w);
+std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& observations) {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(observations.size());
+  for (const auto& o : observations) poses.push_back(o.pose);
+  return poses;
+}
 
+/// Groups the observations: the overlap, W and the partition (sec. II-III).
+template <typename PointT>
+Partition groupObservations(const PartitionArgs& args, ObservationGrouping<PointT>& grouping,
+                            const std::vector<Observation<PointT>>& observations, const InputRecord& input,
+                            Warnings& warn) {
   throwIfInterrupted(args.interrupt);
-  ObservationGrouping<PointT> grouping;
   grouping.setInterruptFlag(args.interrupt);
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   grouping.setSensedSpaceModel(args.sso);
@@ -90,6 +98,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   grouping.setMinGroupSize(args.min_group_size);
   if (args.max_depth) grouping.setMaxDepth(*args.max_depth);
   grouping.setNumberOfThreads(args.threads);
+  grouping.setKeepWorldPoints(args.pictures);  // map.png draws them
   ProgressBar bar("overlap", !args.quiet);
   grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   Partition partition;
@@ -108,50 +117,108 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
     if (points_per_observation[i] == 0 && !observations[i].cloud->empty())
       warn(input.labels[i] + ": only NaN/Inf points; kept as a group of its own");
   for (const auto& w : partition.warnings) warn(w);
+  return partition;
+}
 
-  const auto maps_start = Clock::now();
+template <typename PointT>
+struct MapsOfRun {
+  std::vector<LocalMap<PointT>> maps;
+  TopologicalMap topology;
+  RefinementReport refinement;  ///< summed over the maps: one line for the run, not one per map
+  double voxel = 0.0;
+  double seconds = 0.0;
+};
+
+/// The local maps (refined as asked) and the topological map over them.
+template <typename PointT>
+MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
+                            const Partition& partition, const WeightMatrix& W, Warnings& warn) {
+  const auto start = Clock::now();
+  MapsOfRun<PointT> run;
   LocalMapBuilder<PointT> builder;
   builder.setRefinement(args.refine);
-  const double map_voxel = args.map_voxel.value_or(args.delta / 2);
-  builder.setVoxelLeafSize(map_voxel);
+  run.voxel = args.map_voxel.value_or(args.delta / 2);
+  builder.setVoxelLeafSize(run.voxel);
   builder.setNumberOfThreads(args.threads);
   builder.setInterruptFlag(args.interrupt);
-  const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
+  run.maps = builder.build(observations, partition, W);
   std::vector<LocalMapFrame> frames;
-  RefinementReport refinement;  // one line for the run, not one per map
-  for (std::size_t g = 0; g < maps.size(); ++g) {
-    frames.push_back(maps[g].frame);
-    if (!maps[g].filtered) warn("local map " + std::to_string(g) + ": too large for a " +
-                                          std::to_string(map_voxel) + " m voxel filter; written unfiltered");
-    refinement += maps[g].refinement;
+  for (std::size_t g = 0; g < run.maps.size(); ++g) {
+    frames.push_back(run.maps[g].frame);
+    if (!run.maps[g].filtered)
+      warn("local map " + std::to_string(g) + ": too large for a " + std::to_string(run.voxel) +
+           " m voxel filter; written unfiltered");
+    run.refinement += run.maps[g].refinement;
   }
-  if (!refinement.warning().empty()) warn("refinement: " + refinement.warning());
-  std::vector<Eigen::Isometry3d> poses;
-  for (const auto& o : observations) poses.push_back(o.pose);
-  const TopologicalMap topology = buildTopologicalMap(std::move(frames), grouping.getWeightMatrix(), poses, args.threads);
-  const double maps_s = secondsSince(maps_start);
+  if (!run.refinement.warning().empty()) warn("refinement: " + run.refinement.warning());
+  run.topology = buildTopologicalMap(std::move(frames), W, posesOf(observations), args.threads);
+  run.seconds = secondsSince(start);
+  return run;
+}
+
+/// map.png/.svg, weights.png, fiedler.png and a picture per local map.
+template <typename PointT>
+void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const ObservationGrouping<PointT>& grouping,
+                  const std::vector<Observation<PointT>>& observations, const Partition& partition,
+                  const MapsOfRun<PointT>& maps) {
+  // The points and regions as the grouping saw them, at the input poses;
+  // map.png draws each observation at its refined pose.
+  const WorldPoints& world = grouping.getWorldPoints();
+  ObservationRegions regions;
+  const bool tinted = args.sso != SensedSpaceModel::Points;
+  if (tinted) regions = grouping.getSensedSpaceOverlap().computeRegions(observations, world);
+  io::writeMapPictures(out, world, posesOf(observations), io::refinedPoses(maps.topology, observations.size()),
+                       partition, maps.topology, tinted ? &regions : nullptr);
+  io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
+  io::writeFiedlerPicture(out, partition);
+  io::writeLocalMapPictures(out, maps.maps, args.threads);
+}
+
+/// The method's settings as partition.json records them.
+nlohmann::json methodParameters(const PartitionArgs& args, double diagonal, double map_voxel) {
+  nlohmann::json p;
+  p["sso"] = toString(args.sso);
+  if (args.sso == SensedSpaceModel::Points) {
+    p["delta"] = args.delta;
+  } else {
+    p["cell"] = args.region.cell_size;
+    p["range"] = args.region.max_range;
+    if (args.sso == SensedSpaceModel::Visibility) {
+      p["clearance"] = args.region.clearance;
+      p["min_observations"] = args.region.min_observations;
+      p["band"] = {args.region.band_low, args.region.band_high};
+    }
+  }
+  p["voxel"] = args.voxel;
+  p["ncut_threshold"] = args.ncut_threshold;
+  p["split"] = toString(args.split);
+  p["min_group_size"] = args.min_group_size;
+  p["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
+  p["diagonal"] = diagonal;
+  if (args.sso == SensedSpaceModel::Points) p["neighbour_search"] = "shared_grid";
+  p["map_voxel"] = map_voxel;
+  p["refine"] = toString(args.refine);
+  return p;
+}
+
+template <typename PointT>
+int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
+  Warnings warn(args.quiet);
+  for (const auto& w : input.warnings) warn(w);
+  ObservationGrouping<PointT> grouping;
+  const Partition partition = groupObservations(args, grouping, observations, input, warn);
+  const MapsOfRun<PointT> maps = buildMaps(args, observations, partition, grouping.getWeightMatrix(), warn);
 
   const auto outputs_start = Clock::now();
   io::OutputFolder out(args.output, args.force, args.interrupt);
-  const std::size_t map_points = io::writeLocalMaps(out, maps, args.threads);
-  out.writeText("topology.json", io::topologyJson(topology));
-  out.writeText("topology.dot", io::topologyDot(topology));
-  out.writeText("local_maps/poses.txt", io::localMapPosesTum(topology));
+  const std::size_t map_points = io::writeLocalMaps(out, maps.maps, args.threads);
+  out.writeText("topology.json", io::topologyJson(maps.topology));
+  out.writeText("topology.dot", io::topologyDot(maps.topology));
+  out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
   double pictures_s = 0.0;
   if (args.pictures) {
     const auto pictures_start = Clock::now();
-    // The points and regions as the grouping saw them, at the input poses;
-    // map.png draws each observation at its refined pose.
-    const SensedSpaceOverlap<PointT>& world_frame = grouping.getSensedSpaceOverlap();
-    const WorldPoints world = world_frame.toWorld(observations);
-    ObservationRegions regions;
-    const bool tinted = args.sso != SensedSpaceModel::Points;
-    if (tinted) regions = world_frame.computeRegions(observations, world);
-    io::writeMapPictures(out, world, poses, io::refinedPoses(topology, observations.size()), partition, topology,
-                         tinted ? &regions : nullptr);
-    io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
-    io::writeFiedlerPicture(out, partition);
-    io::writeLocalMapPictures(out, maps, args.threads);
+    drawPictures(args, out, grouping, observations, partition, maps);
     pictures_s = secondsSince(pictures_start);
   }
   const double outputs_s = secondsSince(outputs_start);
@@ -163,52 +230,34 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   run.input = args.input;
   run.parameters = input.parameters;
   run.parameters["format"] = input.format;
-  run.parameters["sso"] = toString(args.sso);
-  if (args.sso == SensedSpaceModel::Points) {
-    run.parameters["delta"] = args.delta;
-  } else {
-    run.parameters["cell"] = args.region.cell_size;
-    run.parameters["range"] = args.region.max_range;
-    if (args.sso == SensedSpaceModel::Visibility) {
-      run.parameters["clearance"] = args.region.clearance;
-      run.parameters["min_observations"] = args.region.min_observations;
-      run.parameters["band"] = {args.region.band_low, args.region.band_high};
-    }
-  }
-  run.parameters["voxel"] = args.voxel;
-  run.parameters["ncut_threshold"] = args.ncut_threshold;
-  run.parameters["split"] = toString(args.split);
-  run.parameters["min_group_size"] = args.min_group_size;
-  run.parameters["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
-  run.parameters["diagonal"] = grouping.getDiagonalWeight();
-  if (args.sso == SensedSpaceModel::Points) run.parameters["neighbour_search"] = "shared_grid";
-  run.parameters["map_voxel"] = map_voxel;
-  run.parameters["refine"] = toString(args.refine);
+  run.parameters.update(methodParameters(args, grouping.getDiagonalWeight(), maps.voxel));
   run.statistics = {{"points", points},
                     {"pairs_evaluated", overlap.pairs_evaluated},
                     {"point_tests", overlap.point_tests},
                     {"edges", overlap.pairs.size()},
                     {"groups", partition.groups.size()},
                     {"local_map_points", map_points},
-                    {"refined_members", refinement.moved},
-                    {"kept_members", refinement.members - refinement.moved}};
+                    {"refined_members", maps.refinement.moved},
+                    {"kept_members", maps.refinement.members - maps.refinement.moved}};
   const auto& t = grouping.getTimings();
   run.warnings = warn.all();
-  run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s}, {"graph", t.graph_s},
-                  {"partition", t.partition_s}, {"local_maps", maps_s},   {"outputs", outputs_s},
-                  {"pictures", pictures_s},     {"threads", args.threads}};
+  run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s},     {"graph", t.graph_s},
+                  {"partition", t.partition_s}, {"local_maps", maps.seconds}, {"outputs", outputs_s},
+                  {"pictures", pictures_s},     {"threads", threadCount(args.threads)}};
   out.writeText("partition.json", io::partitionJson(partition, run));
   out.commit();
 
   if (!args.quiet) {
+    const auto plural = [](std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); };
     std::fprintf(stderr,
-                 "obsgroup: %zu observations (%zu points), %llu pairs evaluated, %zu overlapping, %zu groups\n"
+                 "obsgroup: %s (%s), %s evaluated, %zu overlapping, %s\n"
                  "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
                  " (pictures %.2f s)\n"
                  "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
-                 observations.size(), points, static_cast<unsigned long long>(overlap.pairs_evaluated),
-                 overlap.pairs.size(), partition.groups.size(), input.load_s, t.overlap_s, t.graph_s,
-                 t.partition_s, maps_s, outputs_s, pictures_s, args.output.c_str(),
+                 plural(observations.size(), "observation").c_str(), plural(points, "point").c_str(),
+                 plural(overlap.pairs_evaluated, "pair").c_str(), overlap.pairs.size(),
+                 plural(partition.groups.size(), "group").c_str(), input.load_s, t.overlap_s, t.graph_s,
+                 t.partition_s, maps.seconds, outputs_s, pictures_s, args.output.c_str(),
                  args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
   }
   return 0;

@@ -11,6 +11,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace obsgroup::cli {
 
@@ -40,9 +41,12 @@ struct PartitionArgs {
   int threads = 0;
   std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
   Refinement refine = Refinement::None;
+  bool paper = false;         ///< --paper: the preset, applied by the command line
+  std::vector<double> band;  ///< --band LOW HIGH as given (then in `region`)
   // the run
   bool force = false;
   bool quiet = false;
+  bool no_pictures = false;  ///< --no-pictures as given
   bool pictures = true;
   /// Set (by a SIGINT/SIGTERM handler) to stop the run; the output folder is
   /// then left as it was.

@@ -16,16 +16,6 @@
 
 namespace obsgroup::io {
 
-std::string toString(LaserSource source) {
-  switch (source) {
-    case LaserSource::Auto: return "auto";
-    case LaserSource::Front: return "front";
-    case LaserSource::Rear: return "rear";
-    case LaserSource::RobotLaser: return "robotlaser";
-  }
-  return "?";
-}
-
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;

@@ -3,6 +3,7 @@
 // and ROBOTLASER1 messages.
 
 #include <obsgroup/cloud/observation.h>
+#include <obsgroup/common/enum_names.h>
 
 #include <pcl/point_types.h>
 
@@ -20,6 +21,12 @@ enum class LaserSource {
   Rear,       ///< RLASER
   RobotLaser  ///< ROBOTLASER1
 };
+
+inline constexpr EnumName<LaserSource> kLaserSourceNames[] = {{LaserSource::Auto, "auto"},
+                                                              {LaserSource::Front, "front"},
+                                                              {LaserSource::Rear, "rear"},
+                                                              {LaserSource::RobotLaser, "robotlaser"}};
+inline std::string toString(LaserSource source) { return nameOf(kLaserSourceNames, source); }
 
 struct CarmenOptions {
   LaserSource laser = LaserSource::Auto;
@@ -61,7 +68,5 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
 /// The scan's returns as points in the laser frame (z = 0). Non-finite
 /// readings and readings at or beyond max_range give no point.
 pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan);
-
-std::string toString(LaserSource source);
 
 }  // namespace obsgroup::io

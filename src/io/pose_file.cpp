@@ -10,8 +10,6 @@
 
 namespace obsgroup::io {
 
-std::string toString(PoseFormat format) { return format == PoseFormat::Tum ? "tum" : "kitti"; }
-
 Eigen::Quaterniond checkedQuaternion(double w, double x, double y, double z) {
   const Eigen::Quaterniond q(w, x, y, z);
   const double norm = q.norm();

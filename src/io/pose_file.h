@@ -2,6 +2,8 @@
 // Readers of trajectory files: TUM (timestamp tx ty tz qx qy qz qw) and
 // KITTI (12 numbers per line: a 3x4 row-major [R | t]).
 
+#include <obsgroup/common/enum_names.h>
+
 #include <Eigen/Geometry>
 
 #include <string>
@@ -12,7 +14,8 @@ namespace obsgroup::io {
 
 enum class PoseFormat { Tum, Kitti };
 
-std::string toString(PoseFormat format);
+inline constexpr EnumName<PoseFormat> kPoseFormatNames[] = {{PoseFormat::Tum, "tum"}, {PoseFormat::Kitti, "kitti"}};
+inline std::string toString(PoseFormat format) { return nameOf(kPoseFormatNames, format); }
 
 /// Reads one pose per non-empty, non-comment ('#') line. Throws InputError
 /// naming the file, the line and the field on a wrong number of values, a

@@ -19,22 +19,6 @@
 
 namespace obsgroup {
 
-std::string toString(Refinement refinement) {
-  switch (refinement) {
-    case Refinement::None: return "none";
-    case Refinement::Icp: return "icp";
-    case Refinement::Lum: return "lum";
-  }
-  return "?";
-}
-
-Refinement refinementFromString(const std::string& name) {
-  if (name == "none") return Refinement::None;
-  if (name == "icp") return Refinement::Icp;
-  if (name == "lum") return Refinement::Lum;
-  throw std::invalid_argument("unknown refinement '" + name + "' (expected none, icp or lum)");
-}
-
 std::string RefinementReport::warning() const {
   if (kept_beyond_bound == 0 && kept_unaligned == 0 && pairs_partial == 0) return "";
   std::string text = "refined " + std::to_string(moved) + " of " + std::to_string(members) + " members";

@@ -20,22 +20,6 @@
 
 namespace obsgroup {
 
-std::string toString(SensedSpaceModel model) {
-  switch (model) {
-    case SensedSpaceModel::Points: return "points";
-    case SensedSpaceModel::FreeSpace: return "free-space";
-    case SensedSpaceModel::Visibility: return "visibility";
-  }
-  return "?";
-}
-
-SensedSpaceModel sensedSpaceModelFromString(const std::string& name) {
-  if (name == "points") return SensedSpaceModel::Points;
-  if (name == "free-space") return SensedSpaceModel::FreeSpace;
-  if (name == "visibility") return SensedSpaceModel::Visibility;
-  throw std::invalid_argument("unknown sensed-space model '" + name + "' (points, free-space or visibility)");
-}
-
 namespace {
 
 // --- cells and keys ---------------------------------------------------------

@@ -7,22 +7,6 @@
 
 namespace obsgroup {
 
-std::string toString(SplitCriterion criterion) {
-  switch (criterion) {
-    case SplitCriterion::Mean: return "mean";
-    case SplitCriterion::Sign: return "sign";
-    case SplitCriterion::BestNcut: return "best";
-  }
-  return "?";
-}
-
-SplitCriterion splitCriterionFromString(const std::string& name) {
-  if (name == "mean") return SplitCriterion::Mean;
-  if (name == "sign") return SplitCriterion::Sign;
-  if (name == "best") return SplitCriterion::BestNcut;
-  throw std::invalid_argument("unknown split criterion '" + name + "' (expected mean, sign or best)");
-}
-
 namespace {
 
 /// Sweeps every threshold between distinct values of y (largest first into A)

@@ -25,6 +25,7 @@ void ObservationGrouping<PointT>::clear() {
   observations_.clear();
   overlap_result_ = OverlapResult{};
   W_ = WeightMatrix{};
+  world_ = WorldPoints{};
   warnings_.clear();
 }
 
@@ -35,7 +36,13 @@ Partition ObservationGrouping<PointT>::compute() {
     return std::chrono::duration<double>(Clock::now() - t).count();
   };
   auto start = Clock::now();
-  overlap_result_ = overlap_.compute(observations_);
+  world_ = WorldPoints{};
+  if (keep_world_points_) {
+    world_ = overlap_.toWorld(observations_);
+    overlap_result_ = overlap_.compute(observations_, world_);
+  } else {
+    overlap_result_ = overlap_.compute(observations_);
+  }
   timings_.overlap_s = seconds_since(start);
   start = Clock::now();
   W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, diagonal_);

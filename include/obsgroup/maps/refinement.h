@@ -6,6 +6,7 @@
 /// kept only where it makes the map demonstrably more consistent. Planar
 /// data is refined in SE(2). Not templated: members come as plain points.
 
+#include "obsgroup/common/enum_names.h"
 #include "obsgroup/maps/topological_map.h"
 
 #include <Eigen/Core>
@@ -26,9 +27,14 @@ enum class Refinement {
   Lum
 };
 
-std::string toString(Refinement refinement);
+inline constexpr EnumName<Refinement> kRefinementNames[] = {
+    {Refinement::None, "none"}, {Refinement::Icp, "icp"}, {Refinement::Lum, "lum"}};
+
+inline std::string toString(Refinement refinement) { return nameOf(kRefinementNames, refinement); }
 /// Parses "none", "icp" or "lum"; throws std::invalid_argument otherwise.
-Refinement refinementFromString(const std::string& name);
+inline Refinement refinementFromString(const std::string& name) {
+  return valueNamed(kRefinementNames, name, "refinement");
+}
 
 struct RefinementParameters {
   /// Voxel leaf planar scans are thinned to before alignment, metres...

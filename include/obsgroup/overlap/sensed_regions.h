@@ -17,6 +17,7 @@
 ///    other way in the same room still overlaps.
 /// With either, Pi(i, j) = |R_i and R_j| / |R_i| and Psi is eq. (18) as before.
 
+#include "obsgroup/common/enum_names.h"
 #include "obsgroup/common/interrupt.h"
 #include "obsgroup/overlap/overlap_matrix.h"
 #include "obsgroup/overlap/world_points.h"
@@ -34,9 +35,16 @@ enum class SensedSpaceModel {
   Visibility  ///< Cells visible all around the pose (own beams, then the shared occupancy grid).
 };
 
-std::string toString(SensedSpaceModel model);
+inline constexpr EnumName<SensedSpaceModel> kSensedSpaceModelNames[] = {
+    {SensedSpaceModel::Points, "points"},
+    {SensedSpaceModel::FreeSpace, "free-space"},
+    {SensedSpaceModel::Visibility, "visibility"}};
+
+inline std::string toString(SensedSpaceModel model) { return nameOf(kSensedSpaceModelNames, model); }
 /// Parses "points", "free-space" or "visibility"; throws std::invalid_argument otherwise.
-SensedSpaceModel sensedSpaceModelFromString(const std::string& name);
+inline SensedSpaceModel sensedSpaceModelFromString(const std::string& name) {
+  return valueNamed(kSensedSpaceModelNames, name, "sensed-space model");
+}
 
 /// Parameters of the region models (free space, visibility). The defaults
 /// measured best across 2D lasers and depth cameras, exact and drifted poses

@@ -94,6 +94,9 @@ class SensedSpaceOverlap {
 
   /// Pi and Psi for all pairs. Throws std::invalid_argument on bad parameters.
   OverlapResult compute(const std::vector<Observation<PointT>>& observations) const;
+  /// The same from the observations' points already in the common frame
+  /// (toWorld(observations)), e.g. kept to draw them afterwards.
+  OverlapResult compute(const std::vector<Observation<PointT>>& observations, const WorldPoints& world) const;
 
  private:
   std::vector<Eigen::Vector3f> observationToWorld(const Observation<PointT>& observation,

@@ -2,6 +2,7 @@
 /// \file
 /// Spectral bisection of a graph by minimum normalized cut (paper sec. II-A).
 
+#include "obsgroup/common/enum_names.h"
 #include "obsgroup/spectral/fiedler_vector.h"
 #include "obsgroup/spectral/normalized_cut.h"
 
@@ -12,14 +13,19 @@ namespace obsgroup {
 
 /// How the real-valued Fiedler vector is turned into two groups.
 enum class SplitCriterion {
-  Mean,    ///< y_i > mean(y): the paper's choice (sec. II-A), the default.
+  Mean,    ///< y_i > mean(y): the paper's choice (sec. II-A), PartitionOptions' default.
   Sign,    ///< y_i > 0.
   BestNcut ///< sweep every threshold along the sorted y and keep the smallest Ncut.
 };
 
-std::string toString(SplitCriterion criterion);
+inline constexpr EnumName<SplitCriterion> kSplitCriterionNames[] = {
+    {SplitCriterion::Mean, "mean"}, {SplitCriterion::Sign, "sign"}, {SplitCriterion::BestNcut, "best"}};
+
+inline std::string toString(SplitCriterion criterion) { return nameOf(kSplitCriterionNames, criterion); }
 /// Parses "mean", "sign" or "best"; throws std::invalid_argument otherwise.
-SplitCriterion splitCriterionFromString(const std::string& name);
+inline SplitCriterion splitCriterionFromString(const std::string& name) {
+  return valueNamed(kSplitCriterionNames, name, "split criterion");
+}
 
 struct Bisection {
   FiedlerResult fiedler;    ///< The eigenvector the split was read from.

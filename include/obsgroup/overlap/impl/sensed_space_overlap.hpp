@@ -181,7 +181,17 @@ template <typename PointT>
 OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<PointT>>& observations) const {
   if (!(delta_ > 0.0) || !std::isfinite(delta_))
     throw std::invalid_argument("match distance delta must be finite and > 0");
-  const WorldPoints world = toWorld(observations);
+  return compute(observations, toWorld(observations));
+}
+
+template <typename PointT>
+OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<PointT>>& observations,
+                                                  const WorldPoints& world) const {
+  if (!(delta_ > 0.0) || !std::isfinite(delta_))
+    throw std::invalid_argument("match distance delta must be finite and > 0");
+  if (world.size() != static_cast<int>(observations.size()))
+    throw std::invalid_argument("world points of " + std::to_string(world.size()) + " observations for " +
+                                std::to_string(observations.size()));
   if (model_ != SensedSpaceModel::Points) {
     if (progress_) progress_(0, observations.size());
     std::vector<Eigen::Vector3d> origins(observations.size());
