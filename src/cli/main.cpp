@@ -38,7 +38,9 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
   using obsgroup::SplitCriterion;
   using obsgroup::io::LaserSource;
   using obsgroup::io::PoseFormat;
-  command.add_option("input", args.input, "CARMEN log (.clf, .log, .gfs.log) or folder of .pcd files")->required();
+  command.add_option("input", args.input,
+                     "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input) or folder of .pcd files")
+      ->required();
   command.add_option("-o,--output", args.output, "folder to write the results to")->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
       ->check(CLI::IsMember({"auto", "carmen", "pcd"}));
@@ -53,6 +55,9 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, 
       ->group("CARMEN logs");
   command.add_option("--max-range", max_range, "CARMEN: readings at or beyond this are no return, metres")
       ->check(CLI::PositiveNumber)
+      ->group("CARMEN logs");
+  command.add_flag("--skip-bad-lines", args.skip_bad_lines,
+                   "CARMEN: skip malformed lines (a truncated last line, say), counted in one warning")
       ->group("CARMEN logs");
 
   command.add_option("--poses", poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
@@ -166,6 +171,10 @@ int main(int argc, char** argv) {
   if (partition->count("--fov")) args.field_of_view_deg = fov;
   if (partition->count("--max-range")) args.max_range = max_range;
   if (partition->count("--poses")) args.poses = poses;
+  if (partition->count("--pose-format") && !args.poses) {
+    std::fprintf(stderr, "obsgroup: error: --pose-format applies to a --poses file (PCD sequences)\n");
+    return 2;
+  }
   if (partition->count("--max-depth")) args.max_depth = max_depth;
   if (partition->count("--map-voxel")) args.map_voxel = map_voxel;
   // Options of one model given with another are a mistake, not a no-op.
