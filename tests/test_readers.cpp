@@ -264,7 +264,8 @@ constexpr double kPi = 3.14159265358979323846;
 /// The angles of a scan's points, radians.
 std::vector<double> angles(const LaserScan& scan) {
   std::vector<double> out;
-  for (const auto& p : scanToCloud(scan)->points) out.push_back(std::atan2(p.y, p.x));
+  const auto cloud = scanToCloud(scan);
+  for (const auto& p : cloud->points) out.push_back(std::atan2(p.y, p.x));
   return out;
 }
 
