@@ -414,3 +414,27 @@ TEST(Readers, APoseLineOfTheOtherFormatSaysWhichItIs) {
     EXPECT_NE(std::string(e.what()).find("--pose-format kitti"), std::string::npos) << e.what();
   }
 }
+
+TEST(Readers, VerticesApplyAcrossTheSlicesOfALargeLog) {
+  // Every 50th line a vertex; slices cut between a vertex and its scan on some thread counts.
+  std::map<int, std::string> vertices;
+  for (int line = 50; line < 1200; line += 50) vertices[line] = "VERTEX2 " + std::to_string(line) + " 100 " + std::to_string(line) + " 0";
+  const std::string log = bigLog(1200, vertices);
+  CarmenOptions options;
+  std::vector<CarmenLog> logs;
+  for (int threads : {1, 2, 3, 7}) {
+    options.threads = threads;
+    logs.push_back(parseCarmenLog(log, "graph.clf", options));
+  }
+  // The scan after line 50 is line 51: its laser pose is the vertex's.
+  const LaserScan& after = logs[0].scans.at(48);
+  ASSERT_EQ(after.line, 51u);
+  EXPECT_DOUBLE_EQ(after.laser_pose.translation().x(), 100.0);
+  EXPECT_DOUBLE_EQ(after.laser_pose.translation().y(), 50.0);
+  for (const CarmenLog& other : logs) {
+    ASSERT_EQ(other.scans.size(), logs[0].scans.size());
+    for (std::size_t k = 0; k < other.scans.size(); ++k)
+      EXPECT_TRUE(other.scans[k].laser_pose.isApprox(logs[0].scans[k].laser_pose, 0.0)) << k;
+    EXPECT_EQ(other.warnings, logs[0].warnings);
+  }
+}
