@@ -123,7 +123,7 @@ std::string gunzip(std::string_view bytes, const std::string& name) {
   std::string out(sizeHint(bytes), '\0');  // one buffer, of the final size when the trailer says it
   std::size_t produced = 0;
 #ifdef OBSGROUP_HAVE_LIBDEFLATE
-  // libdeflate inflates a whole member about three times as fast as zlib,
+  // libdeflate inflates a whole member about twice as fast as zlib,
   // but only into a buffer large enough; whatever it cannot do (a member
   // larger than the hint, bad or cut data, for zlib's precise message) is
   // left to zlib from that member on.
