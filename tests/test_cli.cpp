@@ -873,3 +873,68 @@ TEST_F(Cli, ThePaperPresetGivesThePapersGroups) {
   ASSERT_EQ(run("partition " + kData + "/office_3d/pcd --force -q --no-pictures -o " + (dir_ / "d").string()).code, 0);
   EXPECT_LT(readJson(dir_ / "d" / "partition.json").at("groups").size(), expected.at("office_3d").size());
 }
+
+TEST_F(Cli, GzipLogsAndLogsOnAPipeReadAsTheFile) {
+  writeFile(dir_ / "office.log", simulatedLog("ROBOTLASER1"));
+  const std::string plain = (dir_ / "office.log").string();
+  ASSERT_EQ(run("partition " + plain + " -q --no-pictures -o " + (dir_ / "p").string()).code, 0);
+  const auto expected = readJson(dir_ / "p" / "partition.json").at("groups");
+  // gzip on disk (told by its bytes, whatever its name), on a pipe, and a plain log on a pipe.
+  ASSERT_EQ(std::system(("gzip -c " + plain + " > " + (dir_ / "office.log.gz").string() + " && cp " +
+                         (dir_ / "office.log.gz").string() + " " + (dir_ / "renamed.clf").string()).c_str()), 0);
+  const std::vector<std::pair<std::string, std::string>> inputs{
+      {"gz", (dir_ / "office.log.gz").string()},
+      {"renamed", (dir_ / "renamed.clf").string()},
+      {"pipe", "- < " + plain},
+      {"gz_pipe", "- < " + (dir_ / "office.log.gz").string()}};
+  for (const auto& [name, input] : inputs) {
+    const Result r = run("partition " + input + " -q --no-pictures -o " + (dir_ / name).string());
+    ASSERT_EQ(r.code, 0) << name << ": " << r.err;
+    EXPECT_EQ(readJson(dir_ / name / "partition.json").at("groups"), expected) << name;
+  }
+  // Errors on a pipe name it.
+  writeFile(dir_ / "bad.log", logWithLine(3, "ROBOTLASER1 0 1"));
+  const Result bad = run("partition - -o " + (dir_ / "b").string() + " < " + (dir_ / "bad.log").string());
+  EXPECT_EQ(bad.code, 3);
+  EXPECT_NE(bad.err.find("<stdin>:3: ROBOTLASER1 line is truncated"), std::string::npos) << bad.err;
+  EXPECT_EQ(run("partition - --format pcd -o " + (dir_ / "c").string() + " < " + plain).code, 2);
+}
+
+TEST_F(Cli, AFieldOfViewInRadiansIsReadAsSuchAndRecorded) {
+  // As MIT CSAIL's log says it: 3.14159 (radians) with a 0.5 degree resolution.
+  writeFile(dir_ / "degrees.log", simulatedLog("FLASER"));
+  writeFile(dir_ / "radians.log", simulatedLog("FLASER", "PARAM laser_front_laser_fov 3.14159 0 host 0\n"
+                                                         "PARAM laser_front_laser_resolution 0.5 0 host 0\n"));
+  ASSERT_EQ(run("partition " + (dir_ / "degrees.log").string() + " -q --no-pictures -o " + (dir_ / "d").string()).code, 0);
+  const Result r = run("partition " + (dir_ / "radians.log").string() + " --no-pictures -o " + (dir_ / "r").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("read as radians"), std::string::npos) << r.err;
+  const auto d = readJson(dir_ / "d" / "partition.json"), p = readJson(dir_ / "r" / "partition.json");
+  EXPECT_NEAR(p.at("parameters").at("fov_deg").get<double>(), 180.0, 1e-3);
+  EXPECT_NE(p.at("parameters").at("fov_source").get<std::string>().find("read as radians"), std::string::npos);
+  EXPECT_EQ(d.at("parameters").at("fov_source"), "default (180 degrees)");
+  EXPECT_EQ(p.at("groups"), d.at("groups"));
+}
+
+TEST_F(Cli, ATruncatedLastLineIsAnErrorUnlessBadLinesAreSkipped) {
+  const std::string log = simulatedLog("ROBOTLASER1");
+  writeFile(dir_ / "cut.clf", log.substr(0, log.size() - 300));  // the recording cut off
+  const Result strict = run("partition " + (dir_ / "cut.clf").string() + " -o " + (dir_ / "s").string());
+  EXPECT_EQ(strict.code, 3);
+  EXPECT_NE(strict.err.find("cut.clf:24: ROBOTLASER1 line is truncated"), std::string::npos) << strict.err;
+  const Result skip = run("partition " + (dir_ / "cut.clf").string() + " --skip-bad-lines --no-pictures -o " +
+                          (dir_ / "k").string());
+  ASSERT_EQ(skip.code, 0) << skip.err;
+  EXPECT_NE(skip.err.find("skipped 1 bad line (first: " + (dir_ / "cut.clf").string() + ":24: ROBOTLASER1 line"),
+            std::string::npos) << skip.err;
+  const auto p = readJson(dir_ / "k" / "partition.json");
+  EXPECT_EQ(p.at("observations"), 23);
+  EXPECT_EQ(run("partition " + kData + "/office_3d/pcd --skip-bad-lines -o " + (dir_ / "x").string()).code, 2);
+}
+
+TEST_F(Cli, APoseFormatWithoutAPosesFileIsRefused) {
+  const Result r = run("partition " + kData + "/office_2d/office.clf --pose-format tum -o " + (dir_ / "o").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--pose-format applies to a --poses file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}

@@ -42,7 +42,9 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   using cli::finiteNumber;
   using cli::oneOf;
   using cli::wholeNumber;
-  command.add_option("input", args.input, "CARMEN log (.clf, .log, .gfs.log) or folder of .pcd files")->required();
+  command.add_option("input", args.input,
+                     "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input) or folder of .pcd files")
+      ->required();
   command.add_option("-o,--output", args.output, "folder to write the results to")->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
       ->check(CLI::IsMember({"auto", "carmen", "pcd"}))
@@ -61,6 +63,9 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
                      "CARMEN: readings at or beyond this are no return, metres (default: the message's, PARAM, "
                      "else 80)")
       ->check(finiteNumber(0.0, true))
+      ->group("CARMEN logs");
+  command.add_flag("--skip-bad-lines", args.skip_bad_lines,
+                   "CARMEN: skip malformed lines (a truncated last line, say), counted in one warning")
       ->group("CARMEN logs");
 
   command.add_option("--poses", args.poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
@@ -172,6 +177,7 @@ std::optional<std::string> commandError(int argc, char** argv, const CLI::App& a
 std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cli::PartitionArgs& args) {
   using obsgroup::SensedSpaceModel;
   using obsgroup::SplitCriterion;
+  if (partition.count("--pose-format") && !args.poses) return "--pose-format applies to a --poses file (PCD sequences)";
   if (args.paper) {
     if (partition.count("--sso") && args.sso != SensedSpaceModel::Points)
       return "--paper uses --sso points; drop one of them";

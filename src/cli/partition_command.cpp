@@ -1,6 +1,7 @@
 #include "partition_command.h"
 
 #include "errors.h"
+#include "input_file.h"
 #include "local_maps.h"
 #include "output_folder.h"
 #include "pcd_sequence.h"
@@ -39,6 +40,10 @@ struct InputRecord {
 
 std::string detectFormat(const PartitionArgs& args) {
   namespace fs = std::filesystem;
+  if (args.input == "-") {  // a log on a pipe
+    if (args.format == "pcd") throw io::UsageError("-: standard input carries a CARMEN log, not a PCD sequence");
+    return "carmen";
+  }
   std::error_code ec;
   if (!fs::exists(args.input, ec)) throw io::InputError(args.input + ": no such file or folder");
   const bool folder = fs::is_directory(args.input, ec);
@@ -56,6 +61,7 @@ void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences only");
   if (format == "pcd" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
+  if (format == "pcd" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
 }
 
 /// Warnings go to stderr as they happen and into partition.json.
@@ -270,7 +276,9 @@ int runCarmen(const PartitionArgs& args) {
   options.field_of_view_deg = args.field_of_view_deg;
   options.max_range = args.max_range;
   options.threads = args.threads;
+  options.skip_bad_lines = args.skip_bad_lines;
   io::CarmenLog log = io::readCarmenLog(args.input, options);
+  const std::string name = io::inputName(args.input);
   const int n = static_cast<int>(log.scans.size());
   std::vector<Observation<pcl::PointXYZ>> observations(n);
   InputRecord input;
@@ -279,13 +287,13 @@ int runCarmen(const PartitionArgs& args) {
 #pragma omp parallel for schedule(dynamic, 64)
   for (int i = 0; i < n; ++i) {
     observations[i] = {io::scanToCloud(log.scans[i]), log.scans[i].laser_pose};
-    input.labels[i] = args.input + ":" + std::to_string(log.scans[i].line);
+    input.labels[i] = name + ":" + std::to_string(log.scans[i].line);
   }
   // The beam geometry actually used (from the messages, PARAM lines or options), as read off the first scan.
   const io::LaserScan& first = log.scans.front();
-  const double fov_deg = first.angle_step * (first.ranges.size() > 1 ? first.ranges.size() - 1 : 0) * 180.0 / M_PI;
   input.parameters = {{"laser", io::toString(log.source)},
-                      {"fov_deg", fov_deg},
+                      {"fov_deg", log.fov_deg},
+                      {"fov_source", log.fov_source},
                       {"max_range", first.max_range},
                       {"point_type", io::toString(io::PointKind::XYZ)}};
   input.warnings = std::move(log.warnings);

@@ -23,6 +23,7 @@ struct PartitionArgs {
   io::LaserSource laser = io::LaserSource::Auto;
   std::optional<double> field_of_view_deg;
   std::optional<double> max_range;
+  bool skip_bad_lines = false;  ///< a bad line is a warning (counted), not an error
   // PCD sequences
   std::optional<std::string> poses;
   io::PoseFormat pose_format = io::PoseFormat::Tum;

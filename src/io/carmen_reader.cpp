@@ -1,17 +1,17 @@
 #include "carmen_reader.h"
 
 #include "errors.h"
+#include "input_file.h"
 #include "text_fields.h"
+
+#include <obsgroup/common/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
-#include <fstream>
+#include <cstdio>
 #include <functional>
 #include <iterator>
 #include <map>
-#include <sstream>
-#include <system_error>
 #include <thread>
 
 namespace obsgroup::io {
@@ -31,23 +31,6 @@ const char* messageName(LaserSource source) {
     case LaserSource::Auto: break;
   }
   return "";
-}
-
-std::string readWholeFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  const std::streamoff size = in.seekg(0, std::ios::end) ? std::streamoff(in.tellg()) : -1;
-  if (size < 0) {  // not seekable (a pipe): stream it
-    in.clear();
-    std::ostringstream content;
-    content << in.rdbuf();
-    return content.str();
-  }
-  std::string content(static_cast<std::size_t>(size), '\0');  // a regular file: one read
-  in.seekg(0);
-  in.read(content.data(), size);
-  content.resize(static_cast<std::size_t>(in.gcount()));
-  return content;
 }
 
 /// Checks that a message line has exactly `expected` fields; otherwise names
@@ -100,6 +83,23 @@ LaserScan parseFrontOrRearLaser(const std::vector<std::string_view>& fields, con
   return scan;
 }
 
+/// The angle between the beams of a ROBOTLASER1 scan, from the fields that
+/// agree: a sensor that includes both ends of its field of view has
+/// resolution * (n - 1) = fov; a full turn (fov = 2 pi) has resolution * n =
+/// fov (beam n would be beam 0 again). Loggers round the resolution, so
+/// within half a beam the field of view gives the exact step. When neither
+/// agrees, the resolution is used and `*disagrees` is set.
+double robotLaserStep(double fov, double resolution, long n, bool* disagrees) {
+  *disagrees = false;
+  if (n < 2) return resolution;
+  const double tolerance = 0.5 * std::abs(resolution);
+  if (std::abs(resolution * (n - 1) - fov) < tolerance) return fov / (n - 1);
+  if (std::abs(std::abs(fov) - 2 * kPi) < std::max(tolerance, 1e-3) && std::abs(resolution * n - fov) < tolerance)
+    return fov / n;
+  *disagrees = true;
+  return resolution;
+}
+
 /// ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy
 /// remission_mode n r1..rn num_remissions [remissions] laser_pose_x laser_pose_y laser_pose_theta
 /// robot_pose_x robot_pose_y robot_pose_theta laser_tv laser_rv forward_safety_dist
@@ -141,10 +141,11 @@ LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const Lin
   const double fov = parseFinite(fields[3], where, "field_of_view");
   const double resolution = parseFinite(fields[4], where, "angular_resolution");
   scan.max_range = parseFinite(fields[5], where, "maximum_range");
-  // Loggers round the resolution; the field of view spans the beams exactly.
-  scan.angle_step = n > 1 ? fov / (n - 1) : resolution;
+  scan.field_of_view = fov;
+  scan.angle_step = robotLaserStep(fov, resolution, n, &scan.step_disagrees);
   readRanges(fields, 9, n, where, scan);
   scan.laser_pose = parsePose(fields, tail, where, "laser_pose");
+  scan.robot_pose = parsePose(fields, tail + 3, where, "robot_pose");
   return scan;
 }
 
@@ -157,28 +158,60 @@ struct LaserParams {
   }
 };
 
-void readParam(const std::vector<std::string_view>& fields, const LineRef& where, LaserParams& params) {
+using ParamValue = std::pair<std::string, double>;
+
+std::optional<ParamValue> readParam(const std::vector<std::string_view>& fields, const LineRef& where) {
   static const char* kKnown[] = {"robot_front_laser_max", "robot_rear_laser_max", "laser_front_laser_resolution",
                                  "laser_rear_laser_resolution", "laser_front_laser_fov", "laser_rear_laser_fov"};
-  if (fields.size() < 3) return;
+  if (fields.size() < 3) return std::nullopt;
   const std::string name(fields[1]);
   for (const char* known : kKnown)
-    if (name == known) params.values[name] = parseFinite(fields[2], where, "PARAM " + name);
+    if (name == known) return ParamValue{name, parseFinite(fields[2], where, "PARAM " + name)};
+  return std::nullopt;
 }
 
-/// Beam geometry of FLASER/RLASER scans, which the messages do not carry.
-void applyGeometry(LaserScan& scan, LaserSource source, const LaserParams& params, const CarmenOptions& options) {
-  const std::string side = source == LaserSource::Rear ? "rear" : "front";
-  const std::size_t n = scan.ranges.size();
-  double fov_deg = kDefaultFieldOfViewDeg;
-  if (options.field_of_view_deg) fov_deg = *options.field_of_view_deg;
-  else if (auto fov = params.get("laser_" + side + "_laser_fov")) fov_deg = *fov;
-  else if (auto resolution = params.get("laser_" + side + "_laser_resolution"); resolution && n > 1)
-    fov_deg = *resolution * (n - 1);
-  const double fov = fov_deg * kPi / 180.0;
-  scan.start_angle = -fov / 2;  // centred ahead, counter-clockwise (right to left)
-  scan.angle_step = n > 1 ? fov / (n - 1) : 0.0;
-  scan.max_range = params.get("robot_" + side + "_laser_max").value_or(kDefaultMaxRange);
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+/// The field of view of FLASER/RLASER scans of n beams, in degrees, and
+/// where it came from. CARMEN's PARAM laser_*_laser_fov is in degrees, but
+/// some loggers wrote radians (MIT CSAIL: 3.14159 with a 0.5 degree
+/// resolution and 361 beams): the unit that agrees with resolution * (n - 1)
+/// is taken, or without a resolution, radians for a value up to 2 pi.
+struct FieldOfView {
+  double deg = kDefaultFieldOfViewDeg;
+  std::string source = "default";
+  bool radians_assumed = false;
+};
+
+FieldOfView frontOrRearFieldOfView(const LaserParams& params, const std::string& side, std::size_t n,
+                                   const CarmenOptions& options) {
+  if (options.field_of_view_deg) return {*options.field_of_view_deg, "--fov"};
+  const std::string fov_name = "laser_" + side + "_laser_fov", resolution_name = "laser_" + side + "_laser_resolution";
+  const std::optional<double> fov = params.get(fov_name), resolution = params.get(resolution_name);
+  if (fov) {
+    const double as_radians = *fov * 180.0 / kPi;
+    bool radians = false;
+    std::string why;
+    if (resolution && *resolution > 0 && n > 1 && *fov > 0) {
+      const double expected = *resolution * (n - 1);
+      radians = std::abs(std::log(as_radians / expected)) < std::abs(std::log(*fov / expected));
+      why = "the resolution " + number(*resolution) + " degrees x " + std::to_string(n - 1) + " beam steps make " +
+            number(expected) + " degrees";
+    } else {
+      radians = *fov > 0 && *fov <= 2 * kPi + 1e-3;
+      why = "no scanner covers only " + number(*fov) + " degrees";
+    }
+    if (radians)
+      return {as_radians, "PARAM " + fov_name + " " + number(*fov) + " read as radians (" + why + ")", true};
+    return {*fov, "PARAM " + fov_name + " (degrees)"};
+  }
+  if (resolution && n > 1)
+    return {*resolution * (n - 1), "PARAM " + resolution_name + " x (" + std::to_string(n) + " - 1) beams"};
+  return {kDefaultFieldOfViewDeg, "default (180 degrees)"};
 }
 
 /// A reading that gives a point (see scanToCloud).
@@ -190,164 +223,257 @@ bool hasReturn(const LaserScan& scan) {
   return false;
 }
 
-/// The first error met, by line number.
-struct Failure {
-  std::size_t line = 0;
-  std::exception_ptr error;
-  void keepFirst(std::size_t at, std::exception_ptr e) {
-    if (!error || at < line) {
-      line = at;
-      error = std::move(e);
-    }
-  }
-};
-
-/// What parsing a slice of the log's lines gave: the scans of the chosen
-/// message, the PARAM lines (indices into the lines, read later in order),
-/// and the first error, after which the slice stops.
-struct ParsedSlice {
-  std::vector<LaserScan> scans;
-  std::vector<std::size_t> param_lines;
-  Failure failure;
-};
-
 using NumberedLines = std::vector<std::pair<std::size_t, std::string_view>>;  // (line number, text)
 
-void parseSlice(const NumberedLines& lines, std::size_t begin, std::size_t end, const std::string& path,
-                LaserSource source, ParsedSlice& out) {
-  const std::string_view chosen = messageName(source);
-  for (std::size_t k = begin; k < end; ++k) {
-    const auto& [line_number, line] = lines[k];
-    try {
-      const auto fields = splitFields(line);
-      if (fields.empty() || fields[0].front() == '#') continue;
-      if (fields[0] == "PARAM") {
-        out.param_lines.push_back(k);
-      } else if (fields[0] == chosen) {
-        const LineRef where{path, line_number};
-        LaserScan scan = source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
-                                                           : parseFrontOrRearLaser(fields, where);
-        scan.line = line_number;
-        out.scans.push_back(std::move(scan));
+/// The log cut into numbered lines, and how many messages of each laser kind it holds.
+struct LogLines {
+  NumberedLines lines;
+  std::map<LaserSource, std::size_t> counts;
+};
+
+bool startsWithMessage(std::string_view line, std::string_view name) {
+  return line.substr(0, name.size()) == name &&
+         (line.size() == name.size() || line[name.size()] == ' ' || line[name.size()] == '\t');
+}
+
+LogLines splitLines(std::string_view content) {
+  LogLines log;
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < content.size();) {
+    std::size_t end = content.find('\n', start);
+    if (end == std::string::npos) end = content.size();
+    const std::string_view line(content.data() + start, end - start);
+    log.lines.emplace_back(++number, line);
+    for (LaserSource s : {LaserSource::Front, LaserSource::Rear, LaserSource::RobotLaser})
+      if (startsWithMessage(line, messageName(s))) ++log.counts[s];
+    start = end + 1;
+  }
+  return log;
+}
+
+/// The laser messages to read: the option's, or ROBOTLASER1, else FLASER,
+/// else RLASER; warns when the log holds others too.
+LaserSource chooseSource(std::map<LaserSource, std::size_t>& counts, const CarmenOptions& options,
+                         const std::string& path, std::vector<std::string>& warnings) {
+  LaserSource source = options.laser;
+  if (source == LaserSource::Auto) {
+    for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
+      if (counts[s] > 0) {
+        source = s;
+        break;
       }
-    } catch (...) {
-      out.failure.keepFirst(line_number, std::current_exception());
-      return;
+    if (source == LaserSource::Auto)
+      throw InputError(path + ": no FLASER, RLASER or ROBOTLASER1 message: is this a CARMEN log?");
+  }
+  const std::string chosen = messageName(source);
+  if (counts[source] == 0)
+    throw InputError(path + ": no " + chosen + " message in this log (--laser " + toString(source) + ")");
+  std::string others;
+  for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
+    if (s != source && counts[s] > 0)
+      others += (others.empty() ? "" : ", ") + std::to_string(counts[s]) + " " + messageName(s);
+  if (!others.empty())
+    warnings.push_back(path + ": using the " + std::to_string(counts[source]) + " " + chosen +
+                       " scans; the log also has " + others + " (choose with --laser)");
+  return source;
+}
+
+/// A pose of a SLAM graph (VERTEX2 id x y theta, or g2o's VERTEX_SE2): the
+/// corrected pose of the scan that follows it.
+struct Vertex {
+  std::size_t line = 0;
+  Eigen::Isometry3d pose;
+};
+
+/// What parsing a slice of the log's lines gave, in line order: the scans of
+/// the chosen message, the PARAM values, the graph vertices and, with
+/// skip_bad_lines, the errors of the lines skipped.
+struct ParsedSlice {
+  std::vector<LaserScan> scans;
+  std::vector<ParamValue> params;
+  std::vector<Vertex> vertices;
+  std::vector<std::string> bad_lines;
+};
+
+bool isVertex(std::string_view message) { return message == "VERTEX2" || message == "VERTEX_SE2"; }
+
+void parseLine(std::string_view line, std::size_t line_number, const std::string& path, LaserSource source,
+               ParsedSlice& out) {
+  const auto fields = splitFields(line);
+  if (fields.empty() || fields[0].front() == '#') return;
+  const LineRef where{path, line_number};
+  if (fields[0] == "PARAM") {
+    if (auto value = readParam(fields, where)) out.params.push_back(std::move(*value));
+  } else if (isVertex(fields[0])) {
+    if (fields.size() < 5)
+      throw inputError(path, line_number,
+                       std::string(fields[0]) + " line is truncated: expected id x y theta after " +
+                           std::string(fields[0]));
+    out.vertices.push_back({line_number, parsePose(fields, 2, where, "vertex")});
+  } else if (fields[0] == messageName(source)) {
+    LaserScan scan = source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
+                                                       : parseFrontOrRearLaser(fields, where);
+    if (source != LaserSource::RobotLaser) scan.robot_pose = scan.laser_pose;
+    scan.line = line_number;
+    out.scans.push_back(std::move(scan));
+  }
+}
+
+/// Parses lines [begin, end); throws the first bad line's error, or records
+/// it and goes on when `skip_bad_lines`.
+void parseSlice(const NumberedLines& lines, std::size_t begin, std::size_t end, const std::string& path,
+                LaserSource source, bool skip_bad_lines, ParsedSlice& out) {
+  for (std::size_t k = begin; k < end; ++k) {
+    try {
+      parseLine(lines[k].second, lines[k].first, path, source, out);
+    } catch (const InputError& e) {
+      if (!skip_bad_lines) throw;
+      out.bad_lines.push_back(e.what());
     }
   }
 }
 
 /// Threads worth starting for a log of `bytes`: small logs (and fuzzing
 /// inputs) are parsed on the calling thread.
-unsigned threadsFor(std::size_t bytes, const CarmenOptions& options) {
+int threadsFor(std::size_t bytes, const CarmenOptions& options) {
   if (bytes < (std::size_t(1) << 20)) return 1;
-  const unsigned all = std::max(1u, std::thread::hardware_concurrency());
-  return options.threads > 0 ? static_cast<unsigned>(options.threads) : all;
+  const int all = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return options.threads > 0 ? options.threads : all;
 }
 
 /// The lines cut into one slice per thread, parsed in parallel; the slices
-/// are in line order, so the result does not depend on the thread count.
+/// are in line order, so the result (and the error of the first bad line)
+/// does not depend on the thread count.
 std::vector<ParsedSlice> parseSlices(const NumberedLines& lines, const std::string& path, LaserSource source,
-                                     unsigned threads) {
+                                     bool skip_bad_lines, int threads) {
   const std::size_t count = std::max<std::size_t>(1, std::min<std::size_t>(threads, lines.size()));
   std::vector<ParsedSlice> slices(count);
-  const auto parse = [&](std::size_t t) {
-    parseSlice(lines, lines.size() * t / count, lines.size() * (t + 1) / count, path, source, slices[t]);
-  };
-  std::vector<std::thread> workers;
-  std::size_t on_workers = 1;  // slices [1, on_workers) have a thread
-  try {
-    for (; on_workers < count; ++on_workers) workers.emplace_back(parse, on_workers);
-  } catch (const std::system_error&) {
-    // No more threads to be had: this thread parses the rest.
-  }
-  for (std::size_t t = on_workers; t < count; ++t) parse(t);
-  parse(0);
-  for (auto& worker : workers) worker.join();
+  parallelFor(count, threads, [&](std::size_t t) {
+    parseSlice(lines, lines.size() * t / count, lines.size() * (t + 1) / count, path, source, skip_bad_lines,
+               slices[t]);
+  });
   return slices;
 }
 
-}  // namespace
-
-CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
-  return parseCarmenLog(readWholeFile(path), path, options);
+/// Each vertex's pose replaces the pose of the scan that follows it (before
+/// the next vertex); the laser keeps its mounting on the robot.
+void applyVertices(std::vector<LaserScan>& scans, const std::vector<Vertex>& vertices, const std::string& path,
+                   std::vector<std::string>& warnings) {
+  if (vertices.empty()) return;
+  std::size_t v = 0, used = 0;
+  std::optional<Eigen::Isometry3d> pending;
+  for (LaserScan& scan : scans) {
+    while (v < vertices.size() && vertices[v].line < scan.line) pending = vertices[v++].pose;
+    if (!pending) continue;
+    scan.laser_pose = *pending * (scan.robot_pose.inverse() * scan.laser_pose);
+    scan.robot_pose = *pending;
+    pending.reset();
+    ++used;
+  }
+  warnings.push_back(path + ": a SLAM graph log: the poses of " + std::to_string(used) + " of " +
+                     std::to_string(vertices.size()) + " VERTEX2 lines replace those of the scans that follow them (" +
+                     std::to_string(scans.size() - used) + " scans keep their own); EDGE2 lines are ignored");
 }
 
-CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options) {
-  if (content.find_first_not_of(" \t\r\n") == std::string_view::npos) throw InputError(path + ": the file is empty");
+/// Beam geometry of FLASER/RLASER scans, which the messages do not carry.
+void applyGeometry(LaserScan& scan, const FieldOfView& fov, double max_range) {
+  const std::size_t n = scan.ranges.size();
+  const double fov_rad = fov.deg * kPi / 180.0;
+  scan.field_of_view = fov_rad;
+  scan.start_angle = -fov_rad / 2;  // centred ahead, counter-clockwise (right to left)
+  scan.angle_step = n > 1 ? fov_rad / (n - 1) : 0.0;
+  scan.max_range = max_range;
+}
 
-  // First pass: which laser messages the log holds.
-  std::map<LaserSource, std::size_t> counts;
-  NumberedLines lines;
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string::npos) end = content.size();
-    const std::string_view line(content.data() + start, end - start);
-    lines.emplace_back(++number, line);
-    for (LaserSource s : {LaserSource::Front, LaserSource::Rear, LaserSource::RobotLaser}) {
-      const std::string_view name = messageName(s);
-      if (line.substr(0, name.size()) == name && (line.size() == name.size() || line[name.size()] == ' ' ||
-                                                  line[name.size()] == '\t'))
-        ++counts[s];
-    }
-    start = end + 1;
-  }
-
-  CarmenLog log;
-  log.source = options.laser;
-  if (log.source == LaserSource::Auto) {
-    for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
-      if (counts[s] > 0) {
-        log.source = s;
-        break;
-      }
-    if (log.source == LaserSource::Auto)
-      throw InputError(path + ": no FLASER, RLASER or ROBOTLASER1 message: is this a CARMEN log?");
-  }
-  const std::string chosen = messageName(log.source);
-  if (counts[log.source] == 0)
-    throw InputError(path + ": no " + chosen + " message in this log (--laser " + toString(log.source) + ")");
-  std::string others;
-  for (LaserSource s : {LaserSource::RobotLaser, LaserSource::Front, LaserSource::Rear})
-    if (s != log.source && counts[s] > 0)
-      others += (others.empty() ? "" : ", ") + std::to_string(counts[s]) + " " + messageName(s);
-  if (!others.empty())
-    log.warnings.push_back(path + ": using the " + std::to_string(counts[log.source]) + " " + chosen +
-                           " scans; the log also has " + others + " (choose with --laser)");
-
-  // Second pass: parse the chosen messages, slices of lines in parallel,
-  // and then the PARAM lines in order.
-  std::vector<ParsedSlice> slices = parseSlices(lines, path, log.source, threadsFor(content.size(), options));
-  LaserParams params;
-  Failure first_failure;
-  for (const ParsedSlice& slice : slices) {
-    for (std::size_t k : slice.param_lines) {
-      const LineRef where{path, lines[k].first};
-      try {
-        readParam(splitFields(lines[k].second), where, params);
-      } catch (...) {
-        first_failure.keepFirst(lines[k].first, std::current_exception());
-        break;
-      }
-    }
-    if (slice.failure.error) {
-      first_failure.keepFirst(slice.failure.line, slice.failure.error);
-      break;  // later slices hold later lines
-    }
-  }
-  if (first_failure.error) std::rethrow_exception(first_failure.error);
-  for (ParsedSlice& slice : slices)
+/// The scans, PARAM values and vertices of all slices, in line order; the
+/// bad lines skipped are counted in one warning.
+void mergeSlices(std::vector<ParsedSlice>& slices, const std::string& path, CarmenLog& log, LaserParams& params,
+                 std::vector<Vertex>& vertices) {
+  std::string first_bad;
+  for (ParsedSlice& slice : slices) {
+    for (ParamValue& value : slice.params) params.values[value.first] = value.second;  // the last one holds
+    vertices.insert(vertices.end(), slice.vertices.begin(), slice.vertices.end());
     log.scans.insert(log.scans.end(), std::make_move_iterator(slice.scans.begin()),
                      std::make_move_iterator(slice.scans.end()));
+    if (!slice.bad_lines.empty() && first_bad.empty()) first_bad = slice.bad_lines.front();
+    log.skipped_lines += slice.bad_lines.size();
+    slice = {};
+  }
+  if (log.skipped_lines > 0)
+    log.warnings.push_back("skipped " + std::to_string(log.skipped_lines) + " bad line" +
+                           (log.skipped_lines == 1 ? "" : "s") + " (first: " + first_bad + ")");
+  if (log.scans.empty())
+    throw InputError(path + ": no " + std::string(messageName(log.source)) + " scan left after skipping " +
+                     std::to_string(log.skipped_lines) + " bad lines");
+}
+
+/// Geometry and maximum range of every scan, the field of view used, and
+/// the warnings about them (once each).
+void finishScans(CarmenLog& log, const LaserParams& params, const CarmenOptions& options, const std::string& path) {
+  const std::string side = log.source == LaserSource::Rear ? "rear" : "front";
+  const double max_range = params.get("robot_" + side + "_laser_max").value_or(kDefaultMaxRange);
+  std::map<std::size_t, FieldOfView> by_beams;  // FLASER/RLASER: per number of beams
+  const LaserScan* disagreeing = nullptr;
+  std::size_t disagreeing_count = 0;
   for (LaserScan& scan : log.scans) {
-    if (log.source != LaserSource::RobotLaser) applyGeometry(scan, log.source, params, options);
+    if (log.source != LaserSource::RobotLaser) {
+      auto it = by_beams.find(scan.ranges.size());
+      if (it == by_beams.end())
+        it = by_beams.emplace(scan.ranges.size(), frontOrRearFieldOfView(params, side, scan.ranges.size(), options))
+                 .first;
+      applyGeometry(scan, it->second, max_range);
+    } else if (scan.step_disagrees && disagreeing_count++ == 0) {
+      disagreeing = &scan;
+    }
     if (options.max_range) scan.max_range = *options.max_range;
     if (!hasReturn(scan))
       log.warnings.push_back(path + ":" + std::to_string(scan.line) +
                              ": the scan has no return; kept as an observation (a group of its own)");
   }
+  const LaserScan& first = log.scans.front();
+  log.fov_deg = first.field_of_view * 180.0 / kPi;
+  if (log.source == LaserSource::RobotLaser) {
+    log.fov_source = "ROBOTLASER1 field_of_view";
+  } else {
+    const FieldOfView& fov = by_beams.at(first.ranges.size());
+    log.fov_source = fov.source;
+    if (fov.radians_assumed) log.warnings.push_back(path + ": " + fov.source);
+  }
+  if (disagreeing)
+    log.warnings.push_back(path + ":" + std::to_string(disagreeing->line) + ": ROBOTLASER1 field_of_view " +
+                           number(disagreeing->field_of_view) + " is neither angular_resolution x (n - 1) nor x n (n = " +
+                           std::to_string(disagreeing->ranges.size()) + "): the beams are spaced by the resolution, " +
+                           number(disagreeing->angle_step) + " rad (" + std::to_string(disagreeing_count) +
+                           " scans like this)");
+}
+
+CarmenLog parseText(std::string_view content, const std::string& path, const CarmenOptions& options) {
+  content = withoutByteOrderMark(content);
+  if (content.find_first_not_of(" \t\r\n") == std::string_view::npos) throw InputError(path + ": the file is empty");
+  LogLines lines = splitLines(content);  // first pass: which laser messages the log holds
+  CarmenLog log;
+  log.source = chooseSource(lines.counts, options, path, log.warnings);
+  // Second pass: the lines in slices, in parallel.
+  std::vector<ParsedSlice> slices =
+      parseSlices(lines.lines, path, log.source, options.skip_bad_lines, threadsFor(content.size(), options));
+  lines = {};
+  LaserParams params;
+  std::vector<Vertex> vertices;
+  mergeSlices(slices, path, log, params, vertices);
+  applyVertices(log.scans, vertices, path, log.warnings);
+  finishScans(log, params, options, path);
   return log;
+}
+
+}  // namespace
+
+CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
+  return parseCarmenLog(readInputBytes(path), inputName(path), options);
+}
+
+CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options) {
+  if (isGzip(content)) return parseText(gunzip(content, path), path, options);
+  return parseText(content, path, options);
 }
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan) {

@@ -1,6 +1,7 @@
 #pragma once
-// Reader of CARMEN logs (.clf, .log, GMapping's .gfs.log): FLASER, RLASER
-// and ROBOTLASER1 messages.
+// Reader of CARMEN logs (.clf, .log, GMapping's .gfs.log, each also
+// gzipped): FLASER, RLASER and ROBOTLASER1 messages, and the VERTEX2 poses
+// of SLAM graph logs.
 
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
@@ -38,6 +39,9 @@ struct CarmenOptions {
   std::optional<double> max_range;
   /// Threads parsing a large log (0 = all cores); the result is the same for any number.
   int threads = 0;
+  /// A bad line of a read message (laser, PARAM, VERTEX2) is skipped, and
+  /// counted in one warning, instead of being an error.
+  bool skip_bad_lines = false;
 };
 
 /// One scan: ranges and beam geometry in the laser frame (x ahead, y left),
@@ -48,6 +52,10 @@ struct LaserScan {
   double angle_step = 0.0;   ///< angle between consecutive beams
   double max_range = 0.0;
   Eigen::Isometry3d laser_pose = Eigen::Isometry3d::Identity();
+  /// The robot's pose (ROBOTLASER1); FLASER/RLASER: the laser's.
+  Eigen::Isometry3d robot_pose = Eigen::Isometry3d::Identity();
+  double field_of_view = 0.0;   ///< radians, as the message (or PARAM, option) says
+  bool step_disagrees = false;  ///< ROBOTLASER1: fov and resolution disagree; spaced by the resolution
   std::size_t line = 0;  ///< line of the log it came from
 };
 
@@ -55,14 +63,21 @@ struct CarmenLog {
   std::vector<LaserScan> scans;
   LaserSource source = LaserSource::Auto;  ///< the message kind actually used
   std::vector<std::string> warnings;       ///< things the user should know
+  double fov_deg = 0.0;     ///< field of view of the first scan, degrees
+  std::string fov_source;   ///< where it came from (message, PARAM and the unit assumed, option, default)
+  std::size_t skipped_lines = 0;  ///< bad lines skipped (skip_bad_lines)
 };
 
-/// Reads a log. Throws InputError naming file, line and field on malformed
-/// input (an empty file, a truncated line, a non-numeric field, a count of
-/// ranges that does not match the line, or no laser message at all).
+/// Reads a log ("-": standard input), gzipped or not (told by its first
+/// bytes), with or without a UTF-8 byte-order mark. Throws InputError naming
+/// file, line and field on malformed input (an empty file, a truncated
+/// line, a non-numeric field, a count of ranges that does not match the
+/// line, or no laser message at all; corrupt or cut gzip data). A VERTEX2
+/// (or VERTEX_SE2) id x y theta line gives the robot's pose of the next scan.
 CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options = {});
 
-/// The same from a log's content already in memory; `path` names it in errors.
+/// The same from a log's content (gzipped or not) already in memory; `path`
+/// names it in errors.
 CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options = {});
 
 /// The scan's returns as points in the laser frame (z = 0). Non-finite

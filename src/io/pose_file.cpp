@@ -1,11 +1,10 @@
 #include "pose_file.h"
 
 #include "errors.h"
+#include "input_file.h"
 #include "text_fields.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 namespace obsgroup::io {
@@ -49,17 +48,22 @@ Eigen::Isometry3d parseKitti(const std::vector<std::string_view>& f, const LineR
   return pose;
 }
 
+/// A line with the other format's number of values: say so.
+std::string otherFormatHint(std::size_t values, PoseFormat format) {
+  if (format == PoseFormat::Tum && values == 12) return "; 12 values are a KITTI line: --pose-format kitti?";
+  if (format == PoseFormat::Kitti && values == 8) return "; 8 values are a TUM line: --pose-format tum?";
+  return "";
+}
+
 }  // namespace
 
 std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat format) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the poses file");
-  std::ostringstream content;
-  content << in.rdbuf();
-  return parsePoses(content.str(), path, format);
+  return parsePoses(readInputBytes(path, "poses file"), inputName(path), format);
 }
 
 std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format) {
+  if (isGzip(content)) return parsePoses(gunzip(content, path), path, format);
+  content = withoutByteOrderMark(content);
   const std::size_t expected = format == PoseFormat::Tum ? 8 : 12;
   const std::string layout = format == PoseFormat::Tum ? "TUM: timestamp tx ty tz qx qy qz qw"
                                                        : "KITTI: 12 values of a 3x4 [R|t] matrix";
@@ -77,7 +81,7 @@ std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::s
     if (fields.size() != expected)
       throw inputError(path, number,
                        "a pose line has " + std::to_string(fields.size()) + " values, expected " +
-                           std::to_string(expected) + " (" + layout + ")");
+                           std::to_string(expected) + " (" + layout + ")" + otherFormatHint(fields.size(), format));
     poses.push_back(format == PoseFormat::Tum ? parseTum(fields, where) : parseKitti(fields, where));
   }
   if (poses.empty()) throw InputError(path + ": the poses file holds no pose");
