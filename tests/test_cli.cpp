@@ -116,12 +116,18 @@ void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
     pcl::PointCloud<pcl::PointXYZ> map;
     EXPECT_EQ(pcl::io::loadPCDFile((out / "local_maps" / name).string(), map), 0) << name;
   }
-  EXPECT_FALSE(fs::exists(out / "local_maps" / ("group_" + std::to_string(1000 + groups) + ".pcd")));
+  // Exactly one map and one picture per group, and the poses: nothing else.
+  std::set<std::string> expected{"poses.txt"}, written;
   for (std::size_t g = 0; g < groups; ++g) {
     char name[32];
     std::snprintf(name, sizeof name, "group_%03zu.png", g);
     expectValidPng(out / "local_maps" / name);
+    expected.insert(name);
+    std::snprintf(name, sizeof name, "group_%03zu.pcd", g);
+    expected.insert(name);
   }
+  for (const auto& entry : fs::directory_iterator(out / "local_maps")) written.insert(entry.path().filename().string());
+  EXPECT_EQ(written, expected);
   const nlohmann::json topology = readJson(out / "topology.json");
   EXPECT_EQ(topology.at("nodes").size(), groups);
   for (const auto& arc : topology.at("arcs")) {
@@ -142,13 +148,17 @@ void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
     EXPECT_NEAR(map.sensor_origin_.x(), node.at("pose").at("x").get<double>(), 1e-3);
     EXPECT_NEAR(map.sensor_origin_.y(), node.at("pose").at("y").get<double>(), 1e-3);
   }
-  EXPECT_EQ(readFile(out / "topology.dot").rfind("graph topology {", 0), 0u);
+  const std::string dot = readFile(out / "topology.dot");
+  EXPECT_EQ(dot.rfind("graph topology {", 0), 0u);
+  EXPECT_EQ(dot.find("e-"), std::string::npos) << "labels are fixed-point";
   expectValidPng(out / "map.png");
   expectValidSvg(out / "map.svg");
   expectValidPng(out / "weights.png");
   expectValidPng(out / "fiedler.png");
-  for (const auto& entry : fs::recursive_directory_iterator(out))
-    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << "left over: " << entry.path();
+  // The run committed its staging folder: none is left beside the results.
+  for (const auto& entry : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(entry.path().filename().string().find(".obsgroup-staging-"), std::string::npos)
+        << "left over: " << entry.path();
 }
 
 /// A CARMEN log line of a simulated scan, in FLASER or ROBOTLASER1 form.

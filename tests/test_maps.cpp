@@ -203,3 +203,47 @@ TEST(LocalMapBuilder, MergedCloudIsInTheReferenceFrameWithItsPose) {
   EXPECT_EQ(refinementFromString("lum"), Refinement::Lum);
   EXPECT_THROW(refinementFromString("slam"), std::invalid_argument);
 }
+
+// The parallel overload builds every group as the one-group call does, for
+// any thread count, and in the partition's order.
+TEST(LocalMapBuilder, AllGroupsAtOnceEqualOneByOneOnAnyThreadCount) {
+  std::vector<Eigen::Isometry3d> truth;
+  auto obs = westRoom(&truth);
+  for (int i = 1; i < 5; ++i) obs[i].pose = obs[i].pose * pose2D(0.03 * i, -0.02 * i, 0.5 * kDeg * i);
+  const WeightMatrix W = chain(5);
+  Partition partition;
+  partition.groups = {{0, 1, 2}, {3, 4}};
+  for (int threads : {1, 2, 3}) {
+    LocalMapBuilder<pcl::PointXYZ> builder;
+    builder.setRefinement(Refinement::Lum);
+    builder.setNumberOfThreads(threads);
+    const auto maps = builder.build(obs, partition, W);
+    ASSERT_EQ(maps.size(), 2u);
+    for (std::size_t g = 0; g < maps.size(); ++g) {
+      const auto one = builder.build(obs, partition.groups[g], W);
+      EXPECT_EQ(maps[g].frame.members, partition.groups[g]);
+      EXPECT_EQ(maps[g].frame.reference, one.frame.reference);
+      for (std::size_t k = 0; k < partition.groups[g].size(); ++k)
+        EXPECT_TRUE(maps[g].frame.member_poses[k].isApprox(one.frame.member_poses[k], 0.0)) << threads << " " << g;
+      ASSERT_EQ(maps[g].cloud->size(), one.cloud->size());
+      for (std::size_t p = 0; p < one.cloud->size(); ++p)
+        ASSERT_EQ((*maps[g].cloud)[p].getVector3fMap(), (*one.cloud)[p].getVector3fMap()) << threads << " " << g;
+    }
+  }
+}
+
+// A group spanning more voxels than the filter's 32-bit indices hold is kept
+// unfiltered (and says so) rather than silently wrong.
+TEST(LocalMapBuilder, TooManyVoxelsKeepsTheMapUnfilteredAndSaysSo) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (int k = 0; k < 10; ++k) cloud->push_back({0.1f * k, 0.0f, 0.0f});
+  std::vector<Observation<pcl::PointXYZ>> obs{{cloud, pose2D(0, 0, 0)}, {cloud, pose2D(3000, 3000, 0)}};
+  LocalMapBuilder<pcl::PointXYZ> builder;
+  builder.setVoxelLeafSize(0.01);  // (3000 m / 1 cm)^2 cells > 2^31
+  const WeightMatrix W = buildWeightMatrix(2, {{0, 1, 0.5}});
+  const auto map = builder.build(obs, {0, 1}, W);
+  EXPECT_FALSE(map.filtered);
+  EXPECT_EQ(map.cloud->size(), 20u);
+  builder.setVoxelLeafSize(0.5);
+  EXPECT_TRUE(builder.build(obs, {0, 1}, W).filtered);
+}

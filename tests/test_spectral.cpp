@@ -197,3 +197,21 @@ TEST(Fiedler, AUsersEliminationOrderGivesThePartitionOfTheSharedOne) {
   options.eigen.elimination_rank = {1, 2, 3};
   EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
 }
+
+// What FiedlerResult promises when lambda_1 is repeated: on a cycle every
+// vector of a two-dimensional eigenspace is a Fiedler vector. Both solvers
+// find lambda_1 with a small residual, each repeats itself exactly, and the
+// vectors are allowed to differ (they do here).
+TEST(Fiedler, RepeatedEigenvalueGuaranteesTheEigenvalueNotTheVector) {
+  const int n = 100;
+  std::vector<WeightedPair> pairs;
+  for (int i = 0; i < n; ++i) pairs.push_back({i, (i + 1) % n, 1.0});
+  const WeightMatrix W = buildWeightMatrix(n, pairs);
+  const double lambda1 = 1.0 - std::cos(2.0 * M_PI / n);  // eigenvalues of the normalized cycle Laplacian
+  for (EigenSolver solver : {EigenSolver::Dense, EigenSolver::Sparse}) {
+    const FiedlerResult first = fiedlerVector(W, withSolver(solver));
+    EXPECT_NEAR(first.eigenvalue, lambda1, 1e-9);
+    EXPECT_LT(residual(W, first), 1e-8);
+    EXPECT_EQ(fiedlerVector(W, withSolver(solver)).y, first.y);
+  }
+}

@@ -111,13 +111,23 @@ std::string localMapPosesTum(const TopologicalMap& map) {
 std::string topologyDot(const TopologicalMap& map) {
   std::ostringstream out;
   out << "graph topology {\n  node [shape=box];\n";
-  for (std::size_t k = 0; k < map.nodes.size(); ++k)
-    out << "  g" << k << " [label=\"group " << k << "\\n" << map.nodes[k].members.size()
-        << " observations\\nreference " << map.nodes[k].reference << "\"];\n";
+  for (std::size_t k = 0; k < map.nodes.size(); ++k) {
+    const std::size_t members = map.nodes[k].members.size();
+    out << "  g" << k << " [label=\"group " << k << "\\n" << members << (members == 1 ? " observation" : " observations")
+        << "\\nreference " << map.nodes[k].reference << "\"];\n";
+  }
+  // Labels are for reading: three decimals (a spread of 6.7e-16 m is 0.000);
+  // topology.json keeps the full values.
+  const auto fixed = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3f", std::abs(v) < 5e-4 ? 0.0 : v);
+    return std::string(text);
+  };
   for (const auto& arc : map.arcs) {
     const Eigen::Vector3d t = arc.transform.translation();
-    out << "  g" << arc.from << " -- g" << arc.to << " [label=\"W " << arc.weight << ", " << arc.pairs
-        << " pairs\\n" << t.norm() << " m +- " << arc.translation_spread << "\"";
+    out << "  g" << arc.from << " -- g" << arc.to << " [label=\"W " << fixed(arc.weight) << ", " << arc.pairs
+        << (arc.pairs == 1 ? " pair" : " pairs") << "\\n" << fixed(t.norm()) << " m +- "
+        << fixed(arc.translation_spread) << " m\"";
     if (arc.overlapping_pairs == 0) out << ", style=dashed";  // joined only by the robot's path
     out << "];\n";
   }

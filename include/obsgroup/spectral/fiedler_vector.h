@@ -16,7 +16,10 @@ namespace obsgroup {
 enum class EigenSolver {
   Auto,   ///< Dense below FiedlerOptions::dense_max_size nodes, sparse above.
   Dense,  ///< Eigen::SelfAdjointEigenSolver on the dense normalized Laplacian.
-  Sparse  ///< Spectra Lanczos in shift-invert mode on the sparse Laplacian.
+  /// Spectra's Lanczos (SymEigsSolver) on the deflated pseudo-inverse of the
+  /// normalized Laplacian (the largest eigenvalue is 1/lambda_1, so no shift
+  /// is tuned), or on the deflated normalized adjacency for dense graphs.
+  Sparse
 };
 
 struct FiedlerOptions {
@@ -51,7 +54,13 @@ class EigenSolverError : public std::runtime_error {
 
 struct FiedlerResult {
   /// y_1 of eq. (10), y = D^-1/2 z with ||z|| = 1, sign fixed so that the
-  /// first clearly non-zero component is positive (dense and sparse agree).
+  /// first clearly non-zero component is positive. Guaranteed: lambda_1 and
+  /// the residual below, whatever the solver, and the same y for the same
+  /// input and solver. When lambda_1 is simple the dense and sparse solvers
+  /// return the same y up to their tolerance; when it is repeated (symmetric
+  /// graphs: on a cycle of 100 nodes the two put 96 nodes on different
+  /// sides) any unit vector of its eigenspace is a Fiedler vector, and each
+  /// solver may return a different one.
   Eigen::VectorXd y;
   double eigenvalue = 0.0;  ///< lambda_1 of eq. (10)/(11).
   bool sparse = false;      ///< true when Spectra computed it.
