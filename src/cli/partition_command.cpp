@@ -151,7 +151,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
                          tinted ? &regions : nullptr);
     io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
     io::writeFiedlerPicture(out, partition);
-    io::writeLocalMapPictures(out, maps, args.threads);
+    io::writeLocalMapPictures(out, maps, args.threads, io::groupColours(topology));
     pictures_s = secondsSince(pictures_start);
   }
   const double outputs_s = secondsSince(outputs_start);
