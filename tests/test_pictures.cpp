@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <random>
@@ -211,24 +212,43 @@ TEST_F(Pictures, NeighbouringGroupsHaveDifferentColours) {
     for (int b = a + 1; b < 4; ++b) EXPECT_NE(colour[a], colour[b]) << a << " " << b;
 }
 
-TEST(GroupColours, NoArcJoinsTwoGroupsOfOneColour) {
-  std::mt19937 random(7);
+/// `n` nodes scattered over 100 m x 7 m, and `arcs` between them: random
+/// ones, or (`random` false) each node's to the next three.
+TopologicalMap randomTopology(int n, int arcs, bool random) {
+  std::mt19937 generator(7);
   TopologicalMap topology;
-  for (int g = 0; g < 300; ++g) {
+  for (int g = 0; g < n; ++g) {
     LocalMapFrame node;
-    node.pose.translation() << std::uniform_real_distribution<double>(0, 100)(random), g % 7, 0;
+    node.pose.translation() << std::uniform_real_distribution<double>(0, 100)(generator), g % 7, 0;
     node.member_poses.push_back(Eigen::Isometry3d::Identity());
     topology.nodes.push_back(node);
   }
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < arcs; ++k) {
     TopologicalArc arc;
-    arc.from = int(random() % 300);
-    arc.to = int(random() % 300);
-    if (arc.from != arc.to) topology.arcs.push_back(arc);
+    arc.from = random ? int(generator() % n) : k / 3;
+    arc.to = random ? int(generator() % n) : k / 3 + 1 + k % 3;
+    arc.weight = double(generator() % 1000);
+    if (arc.from > arc.to) std::swap(arc.from, arc.to);
+    if (arc.from != arc.to && arc.to < n) topology.arcs.push_back(arc);
   }
+  return topology;
+}
+
+TEST(GroupColours, NoArcJoinsTwoGroupsOfOneColour) {
+  const TopologicalMap topology = randomTopology(300, 900, false);
   const std::vector<int> colours = io::groupColours(topology);
   ASSERT_EQ(colours.size(), 300u);
   for (const TopologicalArc& arc : topology.arcs) EXPECT_NE(colours[arc.from], colours[arc.to]);
+  EXPECT_LT(*std::max_element(colours.begin(), colours.end()), 12);
+}
+
+TEST(GroupColours, ADenseTopologyKeepsTheShownArcsApart) {
+  const TopologicalMap topology = randomTopology(300, 6000, true);  // 40 arcs a node
+  const std::vector<int> colours = io::groupColours(topology);
+  ASSERT_EQ(colours.size(), 300u);
+  for (std::size_t a : io::shownArcs(topology, 3))
+    EXPECT_NE(colours[topology.arcs[a].from], colours[topology.arcs[a].to]);
+  EXPECT_LT(*std::max_element(colours.begin(), colours.end()), 12);  // all well separated
 }
 
 TEST(ShownArcs, EachNodeKeepsItsStrongest) {

@@ -24,13 +24,16 @@ struct Rgb {
   double r, g, b;
 };
 
+constexpr int kDistinctColours = 12;  ///< well separated colours of the palette
+constexpr int kArcsPerGroup = 3;      ///< map.png shows each group's strongest arcs
+
 /// Colour `index` of the palette: 12 well separated colours (no grey, which
 /// the arcs use), then golden-angle hues.
 Rgb paletteColour(int index) {
   static const Rgb kPalette[] = {{0.12, 0.47, 0.71}, {1.00, 0.50, 0.05}, {0.17, 0.63, 0.17}, {0.84, 0.15, 0.16},
                                  {0.58, 0.40, 0.74}, {0.55, 0.34, 0.29}, {0.89, 0.47, 0.76}, {0.74, 0.74, 0.13},
                                  {0.09, 0.75, 0.81}, {0.10, 0.15, 0.50}, {0.00, 0.50, 0.42}, {0.60, 0.00, 0.35}};
-  if (index < 12) return kPalette[index];
+  if (index < kDistinctColours) return kPalette[index];
   const double h = std::fmod(index * 0.618033988749895, 1.0) * 6.0;
   const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
   const double c = 0.8, m = 0.1;
@@ -102,8 +105,9 @@ std::pair<double, double> quantiles(std::vector<float>& values, double q) {
 
 /// The bulk of what is drawn: every position, and the points [begin, end)
 /// between the 1st and 99th percentile on each axis (of at most 200000 of
-/// them, evenly spaced), grown by 4% of its larger side (at least 1 m) all
-/// round. A few far returns (through a window, a door) do not set the extent.
+/// them, evenly spaced), grown on each side by 4% of its size on that axis
+/// (at least 1 m). A few far returns (through a window, a door) do not set
+/// the extent.
 Eigen::AlignedBox2d bulkBox(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
                             const std::vector<Eigen::Vector2d>& positions) {
   Eigen::AlignedBox2d box;
@@ -118,7 +122,7 @@ Eigen::AlignedBox2d bulkBox(const Eigen::Vector3f* begin, const Eigen::Vector3f*
     box.extend(Eigen::Vector2d(x1, y1));
   }
   if (box.isEmpty()) return box;
-  const double grow = std::max(1.0, 0.04 * box.sizes().maxCoeff());
+  const Eigen::Array2d grow = (0.04 * box.sizes().array()).max(1.0);
   return Eigen::AlignedBox2d(box.min().array() - grow, box.max().array() + grow);
 }
 
@@ -246,7 +250,6 @@ void drawScaleBar(cairo_t* cr, double scale, double most, double x1, double y) {
 }
 
 constexpr int kLegendHeight = 90;  ///< map.png's legend band
-constexpr int kArcsPerGroup = 3;   ///< map.png shows each group's strongest arcs
 
 /// Sizes of map.png's marks, from the typical distance in pixels between a
 /// group centre and the nearest other one: a picture of 10 groups and one
@@ -353,9 +356,11 @@ void groupMark(cairo_t* cr, double x, double y, int group, const Rgb& c, bool la
 }
 
 /// The groups' marks: numbered where they fit (the larger groups first, no
-/// two numbered circles overlapping), dots elsewhere. Returns how many are
-/// numbered.
+/// two numbered circles overlapping, and when the groups are dense a circle's
+/// width apart so that the map shows between them), dots elsewhere. Returns
+/// how many are numbered.
 std::size_t drawGroupMarks(cairo_t* cr, const MapLayout& layout, const Partition& partition, const MarkSizes& sizes) {
+  const double gap = (sizes.dot_radius < 5.0 ? 4 : 2) * sizes.label_radius + 1;
   std::vector<int> order(partition.groups.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
@@ -364,7 +369,7 @@ std::size_t drawGroupMarks(cairo_t* cr, const MapLayout& layout, const Partition
   std::vector<int> placed;
   for (int g : order) {
     bool fits = true;
-    for (int h : placed) fits = fits && (layout.centres[g] - layout.centres[h]).norm() >= 2 * sizes.label_radius + 1;
+    for (int h : placed) fits = fits && (layout.centres[g] - layout.centres[h]).norm() >= gap;
     if (fits) numbered[g] = true, placed.push_back(g);
   }
   for (int pass = 0; pass < 2; ++pass)  // dots first, numbers on top
@@ -537,7 +542,7 @@ void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFram
                           const std::vector<Eigen::Vector3f>& points, const Rgb& colour) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
   for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
-  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions), 700.0, 480, 20);
+  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions), 700.0, 520, 20);
   Surface surface = imageSurface(v.width, v.height);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
@@ -550,7 +555,7 @@ void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFram
   drawScaleBar(cr.get(), v.scale, (v.width - 2 * v.margin) / 5.0, v.width - v.margin, v.margin / 2);
   cairo_set_source_rgb(cr.get(), 0, 0, 0);
   char caption[200];
-  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; reference %d (black, ringed)",
+  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; ringed: reference %d",
                 group, frame.members.size(), points.size(), frame.reference);
   text(cr.get(), v.margin, v.height - 12, caption, 12);
   char name[64];
@@ -558,13 +563,16 @@ void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFram
   writePng(out, name, surface.get());
 }
 
-/// Neighbours of each node: joined by an arc, or among each other's two
-/// nearest centres (the mean of the members' global poses).
-std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology) {
+/// Neighbours of each node, ascending: joined by one of `arcs` (indices into
+/// topology.arcs), or among each other's two nearest centres (the mean of
+/// the members' global poses).
+std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology, const std::vector<std::size_t>& arcs) {
   const int n = static_cast<int>(topology.nodes.size());
   std::vector<std::vector<int>> neighbours(n);
-  for (const TopologicalArc& arc : topology.arcs)
+  for (std::size_t a : arcs) {
+    const TopologicalArc& arc = topology.arcs[a];
     if (arc.from >= 0 && arc.to < n) neighbours[arc.from].push_back(arc.to), neighbours[arc.to].push_back(arc.from);
+  }
   std::vector<Eigen::Vector3d> centre(n, Eigen::Vector3d::Zero());
   for (int g = 0; g < n; ++g) {
     const LocalMapFrame& node = topology.nodes[g];
@@ -580,27 +588,46 @@ std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology) {
     for (std::size_t j = 0; j < k; ++j)
       neighbours[g].push_back(by_distance[j].second), neighbours[by_distance[j].second].push_back(g);
   }
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
   return neighbours;
+}
+
+/// A greedy colouring (DSATUR: next the node whose neighbours hold the most
+/// distinct colours, then the most neighbours, then the lowest index; the
+/// smallest colour none of them holds).
+std::vector<int> colourGraph(const std::vector<std::vector<int>>& neighbours) {
+  const int n = static_cast<int>(neighbours.size());
+  std::vector<int> colour(n, -1);
+  std::vector<std::vector<char>> seen(n);  // colours held by each node's neighbours
+  std::vector<int> saturation(n, 0);
+  for (int step = 0; step < n; ++step) {
+    int next = -1;
+    for (int g = 0; g < n; ++g)
+      if (colour[g] < 0 && (next < 0 || std::make_pair(saturation[g], neighbours[g].size()) >
+                                            std::make_pair(saturation[next], neighbours[next].size())))
+        next = g;
+    const auto free = std::find(seen[next].begin(), seen[next].end(), 0);
+    colour[next] = int(free - seen[next].begin());
+    for (int h : neighbours[next]) {
+      if (seen[h].size() <= std::size_t(colour[next])) seen[h].resize(colour[next] + 1, 0);
+      if (!seen[h][colour[next]]) seen[h][colour[next]] = 1, ++saturation[h];
+    }
+  }
+  return colour;
 }
 
 }  // namespace
 
 std::vector<int> groupColours(const TopologicalMap& topology) {
-  const std::vector<std::vector<int>> neighbours = groupNeighbours(topology);
-  const int n = static_cast<int>(neighbours.size());
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return neighbours[a].size() > neighbours[b].size(); });
-  std::vector<int> colour(n, -1);
-  std::vector<char> taken;
-  for (int g : order) {
-    taken.assign(neighbours[g].size() + 1, 0);
-    for (int h : neighbours[g])
-      if (colour[h] >= 0 && colour[h] < int(taken.size())) taken[colour[h]] = 1;
-    colour[g] = int(std::find(taken.begin(), taken.end(), 0) - taken.begin());
-  }
-  return colour;
+  std::vector<std::size_t> all(topology.arcs.size());
+  std::iota(all.begin(), all.end(), std::size_t(0));
+  std::vector<int> colours = colourGraph(groupNeighbours(topology, all));
+  if (!colours.empty() && *std::max_element(colours.begin(), colours.end()) >= kDistinctColours)
+    colours = colourGraph(groupNeighbours(topology, shownArcs(topology, kArcsPerGroup)));
+  return colours;
 }
 
 std::vector<std::size_t> shownArcs(const TopologicalMap& topology, int per_node) {
