@@ -104,7 +104,7 @@ std::pair<double, double> quantiles(std::vector<float>& values, double q) {
 }
 
 /// The bulk of what is drawn: every position, and the points [begin, end)
-/// between the 1st and 99th percentile on each axis (of at most 200000 of
+/// between the 2.5th and 97.5th percentile on each axis (of at most 200000 of
 /// them, evenly spaced), grown on each side by 4% of its size on that axis
 /// (at least 1 m). A few far returns (through a window, a door) do not set
 /// the extent.
@@ -116,8 +116,8 @@ Eigen::AlignedBox2d bulkBox(const Eigen::Vector3f* begin, const Eigen::Vector3f*
   if (n > 0) {
     std::vector<float> xs, ys;
     for (std::size_t k = 0; k < n; k += step) xs.push_back(begin[k].x()), ys.push_back(begin[k].y());
-    const auto [x0, x1] = quantiles(xs, 0.01);
-    const auto [y0, y1] = quantiles(ys, 0.01);
+    const auto [x0, x1] = quantiles(xs, 0.025);
+    const auto [y0, y1] = quantiles(ys, 0.025);
     box.extend(Eigen::Vector2d(x0, y0));
     box.extend(Eigen::Vector2d(x1, y1));
   }
@@ -386,55 +386,69 @@ struct LegendText {
   bool regions = false;
 };
 
-/// The legend band below the drawing: one sample of each mark with what it
-/// means, a scale bar, and the counts.
-void drawLegend(cairo_t* cr, const MapLayout& layout, const LegendText& t, const MarkSizes& sizes) {
-  const View& v = layout.view;
-  const double top = layout.legend_top, x0 = v.margin, row = top + 18;
-  cairo_set_source_rgb(cr, 0.96, 0.96, 0.96);
-  cairo_rectangle(cr, 0, top, v.width, v.height - top);
-  cairo_fill(cr);
+/// The legend's first row, at `row`: a group's circle, a dot (when some
+/// groups are not numbered), a pose's arrow; the scale bar on the right.
+void legendMarks(cairo_t* cr, const View& v, double row, const LegendText& t, const MarkSizes& sizes) {
   const Rgb sample = paletteColour(0);
-  groupMark(cr, x0 + 11, row, 7, sample, true, sizes);
+  groupMark(cr, v.margin + 11, row, 7, sample, true, sizes);
   cairo_set_source_rgb(cr, 0, 0, 0);
-  double x = x0 + 28;
+  double x = v.margin + 28;
   x += text(cr, x, row + 4, "group, at its observations' mean", 12) + 14;
-  groupMark(cr, x + 5, row, 0, sample, false, sizes);
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  x += 16 + text(cr, x + 14, row + 4, "group (no room for its number)", 12) + 14;
+  if (t.numbered < t.groups) {
+    groupMark(cr, x + 5, row, 0, sample, false, sizes);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    x += 16 + text(cr, x + 14, row + 4, "group (no room for its number)", 12) + 14;
+  }
   const Rgb arrow = darker(sample);
   cairo_set_source_rgb(cr, arrow.r, arrow.g, arrow.b);
   cairo_set_line_width(cr, 1.5);
   arrowPath(cr, x, row, 0.0, 14);
   cairo_stroke(cr);
   cairo_set_source_rgb(cr, 0, 0, 0);
-  x += 20 + text(cr, x + 20, row + 4, "observation pose (thinned where dense)", 12);
+  text(cr, x + 20, row + 4, "observation pose (thinned where dense)", 12);
   drawScaleBar(cr, v.scale, std::min(320.0, (v.width - 2 * v.margin) / 4.0), v.width - v.margin, row + 2);
+}
 
-  const double row2 = row + 22;
+/// The legend's second row, at `row`: an arc and which are shown, a tinted
+/// cell (with regions); then the counts.
+void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendText& t) {
+  const double x0 = v.margin;
   cairo_set_source_rgba(cr, 0.15, 0.15, 0.15, 0.85);
   cairo_set_line_width(cr, 3);
-  cairo_move_to(cr, x0, row2);
-  cairo_line_to(cr, x0 + 22, row2);
+  cairo_move_to(cr, x0, row);
+  cairo_line_to(cr, x0 + 22, row);
   cairo_stroke(cr);
   cairo_set_source_rgb(cr, 0, 0, 0);
   char arcs[200];
   std::snprintf(arcs, sizeof arcs, "arc of the topology, thicker = larger cut weight: the %d strongest of each group"
                 " (%zu of %zu; all in topology.json)", kArcsPerGroup, t.shown_arcs, t.arcs);
-  x = x0 + 28 + text(cr, x0 + 28, row2 + 4, arcs, 12) + 14;
+  const double x = x0 + 28 + text(cr, x0 + 28, row + 4, arcs, 12) + 14;
   if (t.regions) {
-    const Rgb p = pale(sample);
+    const Rgb p = pale(paletteColour(0));
     cairo_set_source_rgb(cr, p.r, p.g, p.b);
-    cairo_rectangle(cr, x, row2 - 6, 12, 12);
+    cairo_rectangle(cr, x, row - 6, 12, 12);
     cairo_fill(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    text(cr, x + 18, row2 + 4, "space sensed, tinted by the group holding it most", 12);
+    text(cr, x + 18, row + 4, "space sensed, tinted by the group holding it most", 12);
   }
-  char caption[240];
+  char caption[240], outside[64] = "";
+  if (t.outside > 0)
+    std::snprintf(outside, sizeof outside, "; %zu far point%s outside the picture", t.outside,
+                  t.outside == 1 ? "" : "s");
   std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered); neighbouring groups differ in"
-                " colour; %zu far point%s outside the picture", t.observations, t.groups, t.numbered, t.outside,
-                t.outside == 1 ? "" : "s");
-  text(cr, x0, row2 + 24, caption, 12);
+                " colour%s", t.observations, t.groups, t.numbered, outside);
+  text(cr, x0, row + 24, caption, 12);
+}
+
+/// The legend band below the drawing: one sample of each mark with what it
+/// means, a scale bar, and the counts.
+void drawLegend(cairo_t* cr, const MapLayout& layout, const LegendText& t, const MarkSizes& sizes) {
+  const View& v = layout.view;
+  cairo_set_source_rgb(cr, 0.96, 0.96, 0.96);
+  cairo_rectangle(cr, 0, layout.legend_top, v.width, v.height - layout.legend_top);
+  cairo_fill(cr);
+  legendMarks(cr, v, layout.legend_top + 18, t, sizes);
+  legendArcsAndCounts(cr, v, layout.legend_top + 40, t);
 }
 
 
@@ -728,6 +742,63 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& input_world,
   });
 }
 
+namespace {
+
+/// The darkness (W, at most 1) of each pixel of a `side`-pixel square
+/// picture of W whose rows and columns are at `position` (order by group).
+std::vector<float> weightDarkness(const WeightMatrix& W, const std::vector<int>& position, int side) {
+  const double cell = double(side) / W.rows();
+  std::vector<float> darkness(std::size_t(side) * side, 0.0f);
+  for (int col = 0; col < W.outerSize(); ++col)
+    for (WeightMatrix::InnerIterator it(W, col); it; ++it) {
+      const int x0 = int(position[col] * cell), y0 = int(position[it.row()] * cell);
+      const int x1 = std::max(x0 + 1, int((position[col] + 1) * cell));
+      const int y1 = std::max(y0 + 1, int((position[it.row()] + 1) * cell));
+      for (int y = y0; y < std::min(y1, side); ++y)
+        for (int x = x0; x < std::min(x1, side); ++x) {
+          float& d = darkness[std::size_t(y) * side + x];
+          d = std::max(d, static_cast<float>(std::min(1.0, it.value())));
+        }
+    }
+  return darkness;
+}
+
+/// One split's eigenvector in the `w` x `h` box at (ox, oy), its threshold
+/// in red, titled.
+void drawFiedlerPlot(cairo_t* cr, const SplitNode& node, int index, double ox, double oy, double w, double h) {
+  const Eigen::VectorXd& y = node.eigenvector;
+  double lo = std::min(y.minCoeff(), node.threshold), hi = std::max(y.maxCoeff(), node.threshold);
+  if (hi - lo < 1e-12) hi = lo + 1.0;
+  const auto sx = [&](double i) { return ox + (y.size() > 1 ? i / (y.size() - 1) : 0.5) * w; };
+  const auto sy = [&](double value) { return oy + h - (value - lo) / (hi - lo) * h; };
+  cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+  cairo_set_line_width(cr, 1);
+  cairo_rectangle(cr, ox, oy, w, h);
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0.12, 0.47, 0.71);
+  cairo_set_line_width(cr, 1.2);
+  for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr, sx(i), sy(y[i]));
+  cairo_stroke(cr);
+  for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
+    cairo_new_path(cr);
+    cairo_arc(cr, sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
+    cairo_fill(cr);
+  }
+  cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+  cairo_move_to(cr, ox, sy(node.threshold));
+  cairo_line_to(cr, ox + w, sy(node.threshold));
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  char title[200];
+  std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", index, node.members.size(), node.ncut,
+                node.accepted ? "accepted" : "rejected");
+  text(cr, ox, oy - 12, title);
+  text(cr, ox, oy + h + 20, "observation " + std::to_string(node.members.front()) + " ... " +
+                                std::to_string(node.members.back()) + " (in order); red: threshold", 12);
+}
+
+}  // namespace
+
 void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const Partition& partition) {
   const int n = static_cast<int>(W.rows());
   if (n == 0) return;
@@ -743,18 +814,7 @@ void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const P
   const int side = n <= 800 ? n * std::max(1, 800 / n) : 800;
   const double cell = double(side) / n;
   const int margin = 30;
-  std::vector<float> darkness(std::size_t(side) * side, 0.0f);
-  for (int col = 0; col < W.outerSize(); ++col)
-    for (WeightMatrix::InnerIterator it(W, col); it; ++it) {
-      const int x0 = int(position[col] * cell), y0 = int(position[it.row()] * cell);
-      const int x1 = std::max(x0 + 1, int((position[col] + 1) * cell));
-      const int y1 = std::max(y0 + 1, int((position[it.row()] + 1) * cell));
-      for (int y = y0; y < std::min(y1, side); ++y)
-        for (int x = x0; x < std::min(x1, side); ++x) {
-          float& d = darkness[std::size_t(y) * side + x];
-          d = std::max(d, static_cast<float>(std::min(1.0, it.value())));
-        }
-    }
+  const std::vector<float> darkness = weightDarkness(W, position, side);
   Surface surface = imageSurface(side + 2 * margin, side + 2 * margin);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
@@ -799,40 +859,9 @@ void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
     cairo_set_source_rgb(cr.get(), 0, 0, 0);
     text(cr.get(), 20, 40, "No spectral bisection was computed (too few or no overlapping observations).");
   }
-  for (std::size_t k = 0; k < shown.size(); ++k) {
-    const SplitNode& node = *shown[k];
-    const double ox = (k % 2) * plot_w + 50, oy = (k / 2) * plot_h + 40;
-    const double w = plot_w - 80, h = plot_h - 80;
-    const Eigen::VectorXd& y = node.eigenvector;
-    double lo = std::min(y.minCoeff(), node.threshold), hi = std::max(y.maxCoeff(), node.threshold);
-    if (hi - lo < 1e-12) hi = lo + 1.0;
-    const auto sx = [&](double i) { return ox + (y.size() > 1 ? i / (y.size() - 1) : 0.5) * w; };
-    const auto sy = [&](double value) { return oy + h - (value - lo) / (hi - lo) * h; };
-    cairo_set_source_rgb(cr.get(), 0.3, 0.3, 0.3);
-    cairo_set_line_width(cr.get(), 1);
-    cairo_rectangle(cr.get(), ox, oy, w, h);
-    cairo_stroke(cr.get());
-    cairo_set_source_rgb(cr.get(), 0.12, 0.47, 0.71);
-    cairo_set_line_width(cr.get(), 1.2);
-    for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr.get(), sx(i), sy(y[i]));
-    cairo_stroke(cr.get());
-    for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
-      cairo_new_path(cr.get());
-      cairo_arc(cr.get(), sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
-      cairo_fill(cr.get());
-    }
-    cairo_set_source_rgb(cr.get(), 0.85, 0.1, 0.1);
-    cairo_move_to(cr.get(), ox, sy(node.threshold));
-    cairo_line_to(cr.get(), ox + w, sy(node.threshold));
-    cairo_stroke(cr.get());
-    cairo_set_source_rgb(cr.get(), 0, 0, 0);
-    char title[200];
-    std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", int(&node - partition.splits.data()),
-                  node.members.size(), node.ncut, node.accepted ? "accepted" : "rejected");
-    text(cr.get(), ox, oy - 12, title);
-    text(cr.get(), ox, oy + h + 20, "observation " + std::to_string(node.members.front()) + " ... " +
-                                        std::to_string(node.members.back()) + " (in order); red: threshold", 12);
-  }
+  for (std::size_t k = 0; k < shown.size(); ++k)
+    drawFiedlerPlot(cr.get(), *shown[k], int(shown[k] - partition.splits.data()), (k % 2) * plot_w + 50,
+                    (k / 2) * plot_h + 40, plot_w - 80, plot_h - 80);
   writePng(out, "fiedler.png", surface.get());
 }
 

@@ -44,7 +44,7 @@ std::vector<std::size_t> shownArcs(const TopologicalMap& topology, int per_node 
 /// Where map.png puts things.
 struct MapLayout {
   /// The drawing: cropped to the bulk of the observations (every pose and
-  /// the points between the 1st and 99th percentile on each axis) plus a
+  /// the points between the 2.5th and 97.5th percentile on each axis) plus a
   /// margin, so that a few far returns do not shrink the building.
   PictureView view;
   int legend_top = 0;                    ///< The legend: rows [legend_top, view.height).
