@@ -273,6 +273,7 @@ MarkSizes markSizes(const MapLayout& layout, std::size_t observations) {
     spacing = nearest[nearest.size() / 2];
   }
   MarkSizes s;
+  if (c.size() > 1000) s.label_radius = 13;  // room for four digits
   s.dot_radius = std::clamp(0.3 * spacing, 2.5, 5.0);
   s.arc_width = std::clamp(0.15 * spacing, 1.2, 3.5);
   s.arrow = std::clamp(0.5 * layout.view.scale, 6.0, 12.0);
