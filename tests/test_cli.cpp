@@ -823,11 +823,13 @@ TEST_F(Cli, ArcsBetweenGroupsThatDoNotOverlapAreDrawn) {
   ASSERT_EQ(topology.at("nodes").size(), 24u);
   ASSERT_EQ(topology.at("arcs").size(), 23u);
   for (const auto& arc : topology.at("arcs")) EXPECT_EQ(arc.at("weight").get<double>(), 0.0);
-  // Each arc is a dashed stroke of the SVG (a NaN width or opacity drew none).
+  // Each arc is a dark grey stroke of the SVG (a NaN width or opacity drew
+  // none), and so is the legend's sample arc.
   const std::string svg = readFile(dir_ / "o" / "map.svg");
-  std::size_t dashed = 0;
-  for (auto at = svg.find("dasharray:6,4"); at != std::string::npos; at = svg.find("dasharray:6,4", at + 1)) ++dashed;
-  EXPECT_EQ(dashed, 23u);
+  const std::string arc = "stroke:rgb(15%,15%,15%)";
+  std::size_t arcs = 0;
+  for (auto at = svg.find(arc); at != std::string::npos; at = svg.find(arc, at + 1)) ++arcs;
+  EXPECT_EQ(arcs, 23u + 1u);
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   expectValidPng(dir_ / "o" / "map.png");
   EXPECT_EQ(namesIn(dir_ / "o" / "local_maps", "group_", ".png").size(), 24u);

@@ -267,6 +267,58 @@ TEST(ShownArcs, EachNodeKeepsItsStrongest) {
   EXPECT_EQ(io::shownArcs(topology, 5).size(), topology.arcs.size());
 }
 
+TEST_F(Pictures, AThousandGroupsKeepTheirMarksApart) {
+  // 1,000 one-observation groups on a 40 x 25 grid 3 m apart, each joined to
+  // its grid neighbours and to the groups two rows on.
+  Scene scene;  // its four rooms replaced
+  scene.poses.clear();
+  scene.partition = Partition();
+  scene.topology = TopologicalMap();
+  std::vector<std::vector<Eigen::Vector3f>> points;
+  for (int g = 0; g < 1000; ++g) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() << 3.0 * (g % 40), 3.0 * (g / 40), 0;
+    scene.poses.push_back(pose);
+    scene.partition.groups.push_back({g});
+    scene.partition.group_of.push_back(g);
+    LocalMapFrame node;
+    node.members = {g}, node.reference = g, node.pose = pose, node.member_poses = {Eigen::Isometry3d::Identity()};
+    scene.topology.nodes.push_back(node);
+    std::vector<Eigen::Vector3f> wall;
+    for (double t = -1.4; t <= 1.4; t += 0.1) wall.emplace_back(float(pose.translation().x() + t),
+                                                                float(pose.translation().y() + 1.4), 0.f);
+    points.push_back(wall);
+  }
+  scene.world = WorldPoints();
+  scene.world.appendAll(points, 1);
+  for (int g = 0; g < 1000; ++g)
+    for (int h : {g + 1, g + 40, g + 80})
+      if (h < 1000 && (h != g + 1 || h % 40 != 0)) scene.arc(g, h, 1.0 + (g * 7 + h) % 5);
+  const MapLayout layout = scene.layout();
+  EXPECT_LE(layout.view.width, 2800 + 100);
+  EXPECT_LE(layout.shown_arcs.size(), 3000u);
+  EXPECT_LT(layout.shown_arcs.size(), scene.topology.arcs.size());
+  std::size_t numbered = 0;
+  for (int g = 0; g < 1000; ++g) {
+    EXPECT_GT(layout.centres[g].x(), 0);
+    EXPECT_LT(layout.centres[g].x(), layout.view.width);
+    EXPECT_GT(layout.centres[g].y(), 0);
+    EXPECT_LT(layout.centres[g].y(), layout.legend_top);
+    if (!layout.numbered[g]) continue;
+    ++numbered;
+    for (int h = 0; h < g; ++h)
+      if (layout.numbered[h]) {
+        EXPECT_GE((layout.centres[g] - layout.centres[h]).norm(), 2 * layout.label_radius);
+      }
+  }
+  EXPECT_GT(numbered, 50u);
+  for (std::size_t a : layout.shown_arcs)
+    EXPECT_NE(layout.colours[scene.topology.arcs[a].from], layout.colours[scene.topology.arcs[a].to]);
+  const Png png(writeMap(scene));
+  ASSERT_TRUE(png.ok());
+  EXPECT_EQ(png.width(), layout.view.width);
+}
+
 TEST_F(Pictures, LocalMapsHaveAScaleBar) {
   Scene scene;
   std::vector<LocalMap<pcl::PointXYZ>> maps(1);

@@ -356,29 +356,33 @@ void groupMark(cairo_t* cr, double x, double y, int group, const Rgb& c, bool la
   text(cr, x - extents.x_advance / 2, y + size * 0.36, number, size);
 }
 
-/// The groups' marks: numbered where they fit (the larger groups first, no
-/// two numbered circles overlapping, and when the groups are dense a circle's
-/// width apart so that the map shows between them), dots elsewhere. Returns
-/// how many are numbered.
-std::size_t drawGroupMarks(cairo_t* cr, const MapLayout& layout, const Partition& partition, const MarkSizes& sizes) {
+/// Which groups are numbered: where the numbers fit (the larger groups
+/// first, no two numbered circles overlapping, and when the groups are dense
+/// a circle's width apart so that the map shows between them).
+std::vector<char> numberedGroups(const std::vector<Eigen::Vector2d>& centres, const Partition& partition,
+                                 const MarkSizes& sizes) {
   const double gap = (sizes.dot_radius < 5.0 ? 4 : 2) * sizes.label_radius + 1;
   std::vector<int> order(partition.groups.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return partition.groups[a].size() > partition.groups[b].size(); });
-  std::vector<bool> numbered(order.size(), false);
+  std::vector<char> numbered(order.size(), 0);
   std::vector<int> placed;
   for (int g : order) {
     bool fits = true;
-    for (int h : placed) fits = fits && (layout.centres[g] - layout.centres[h]).norm() >= gap;
-    if (fits) numbered[g] = true, placed.push_back(g);
+    for (int h : placed) fits = fits && (centres[g] - centres[h]).norm() >= gap;
+    if (fits) numbered[g] = 1, placed.push_back(g);
   }
+  return numbered;
+}
+
+/// The groups' marks: numbered circles (MapLayout::numbered), dots elsewhere.
+void drawGroupMarks(cairo_t* cr, const MapLayout& layout, const MarkSizes& sizes) {
   for (int pass = 0; pass < 2; ++pass)  // dots first, numbers on top
-    for (std::size_t g = 0; g < order.size(); ++g)
-      if (numbered[g] == (pass == 1))
+    for (std::size_t g = 0; g < layout.centres.size(); ++g)
+      if (bool(layout.numbered[g]) == (pass == 1))
         groupMark(cr, layout.centres[g].x(), layout.centres[g].y(), int(g), paletteColour(layout.colours[g]),
-                  numbered[g], sizes);
-  return placed.size();
+                  layout.numbered[g], sizes);
 }
 
 /// What the legend says beside each mark.
@@ -464,8 +468,9 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
   const MarkSizes sizes = markSizes(layout, positions.size());
   drawArcs(cr, layout, topology, sizes);
   drawPoses(cr, layout, positions, headings, partition, sizes);
+  drawGroupMarks(cr, layout, sizes);
   LegendText legend;
-  legend.numbered = drawGroupMarks(cr, layout, partition, sizes);
+  legend.numbered = std::size_t(std::count(layout.numbered.begin(), layout.numbered.end(), 1));
   legend.observations = positions.size();
   legend.groups = partition.groups.size();
   legend.arcs = topology.arcs.size();
@@ -509,6 +514,9 @@ MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>&
   layout.colours = groupColours(topology);
   layout.colours.resize(partition.groups.size(), 0);  // a topology of other groups
   layout.shown_arcs = shownArcs(topology, kArcsPerGroup);
+  const MarkSizes sizes = markSizes(layout, positions.size());
+  layout.label_radius = sizes.label_radius;
+  layout.numbered = numberedGroups(layout.centres, partition, sizes);
   for (const Eigen::Vector3f& p : world.points) {
     const double x = layout.view.px(p.x()), y = layout.view.py(p.y());
     layout.points_outside += !(x >= 0 && y >= 0 && x < layout.view.width && y < layout.legend_top);

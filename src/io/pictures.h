@@ -51,6 +51,10 @@ struct MapLayout {
   std::vector<Eigen::Vector2d> centres;  ///< Each group's mean position, in pixels.
   std::vector<int> colours;              ///< groupColours()
   std::vector<std::size_t> shown_arcs;   ///< shownArcs()
+  /// Whether each group's mark is a numbered circle of `label_radius` pixels
+  /// (no two overlap) or a dot: numbers where they fit, the larger groups first.
+  std::vector<char> numbered;
+  double label_radius = 11;
   std::size_t points_outside = 0;        ///< Points beyond the crop (not drawn).
 };
 
