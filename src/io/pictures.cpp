@@ -104,20 +104,20 @@ std::pair<double, double> quantiles(std::vector<float>& values, double q) {
 }
 
 /// The bulk of what is drawn: every position, and the points [begin, end)
-/// between the 2.5th and 97.5th percentile on each axis (of at most 200000 of
+/// between the q- and (1-q)-quantiles on each axis (of at most 200000 of
 /// them, evenly spaced), grown on each side by 4% of its size on that axis
 /// (at least 1 m). A few far returns (through a window, a door) do not set
 /// the extent.
 Eigen::AlignedBox2d bulkBox(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
-                            const std::vector<Eigen::Vector2d>& positions) {
+                            const std::vector<Eigen::Vector2d>& positions, double q) {
   Eigen::AlignedBox2d box;
   for (const auto& p : positions) box.extend(p);
   const std::size_t n = std::size_t(end - begin), step = std::max<std::size_t>(1, n / 200000);
   if (n > 0) {
     std::vector<float> xs, ys;
     for (std::size_t k = 0; k < n; k += step) xs.push_back(begin[k].x()), ys.push_back(begin[k].y());
-    const auto [x0, x1] = quantiles(xs, 0.025);
-    const auto [y0, y1] = quantiles(ys, 0.025);
+    const auto [x0, x1] = quantiles(xs, q);
+    const auto [y0, y1] = quantiles(ys, q);
     box.extend(Eigen::Vector2d(x0, y0));
     box.extend(Eigen::Vector2d(x1, y1));
   }
@@ -505,7 +505,8 @@ WorldPoints atDrawnPoses(const WorldPoints& world, const std::vector<Eigen::Isom
 MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions,
                    const Partition& partition, const TopologicalMap& topology) {
   MapLayout layout;
-  const Eigen::AlignedBox2d box = bulkBox(world.points.data(), world.points.data() + world.points.size(), positions);
+  const Eigen::AlignedBox2d box =
+      bulkBox(world.points.data(), world.points.data() + world.points.size(), positions, 0.025);
   // A larger picture for many groups, so that they keep some room each.
   const double longest = std::clamp(1600.0 * std::sqrt(partition.groups.size() / 200.0), 1600.0, 2800.0);
   layout.view = fitView(box, longest, 1100, kLegendHeight);
@@ -565,7 +566,7 @@ void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFram
                           const std::vector<Eigen::Vector3f>& points, const Rgb& colour) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
   for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
-  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions), 700.0, 520, 20);
+  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions, 0.005), 700.0, 520, 20);
   Surface surface = imageSurface(v.width, v.height);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);

@@ -82,10 +82,11 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const s
 /// local_maps/group_NNN.png, numbered like writeLocalMaps' PCD files: each
 /// local map's merged points from above in the map's own frame (x right, y
 /// up), its members' poses as arrows, the reference's drawn black in a ring,
-/// and a scale bar, cropped to the bulk of its points like map.png; about 780
-/// px on the long side. Group g is drawn in colour `colours[g]` (groupColours(),
-/// as in map.png; empty: g). Written on `threads` threads (<= 0: all); each
-/// picture is the same for any number.
+/// and a scale bar, cropped to the bulk of its points (all but the 0.5% at
+/// either end on each axis: fewer are far returns than in map.png); about
+/// 780 px on the long side. Group g is drawn in colour `colours[g]`
+/// (groupColours(), as in map.png; empty: g). Written on `threads` threads
+/// (<= 0: all); each picture is the same for any number.
 template <typename PointT>
 void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0,
                            const std::vector<int>& colours = {});
