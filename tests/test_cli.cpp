@@ -658,7 +658,7 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
   // Ctrl-C at every stage of a rerun with other parameters: reading, overlap,
   // partition, local maps, pictures, the swap. Each outcome is whole.
   bool saw_interrupted = false, saw_completed = false;
-  for (int ms = 0; ms <= 1500 && !saw_completed; ms += 30) {
+  for (int ms = 0; ms <= 4000 && !saw_completed; ms += 30) {  // ends at the first completed run
     const int code = runInterruptedAfter(
         {"partition", input, "--paper", "--delta", "0.2", "--force", "--threads", "1", "-o", out.string()},
         std::chrono::milliseconds(ms));
