@@ -177,7 +177,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
                        partition, maps.topology, tinted ? &regions : nullptr);
   io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
   io::writeFiedlerPicture(out, partition);
-  io::writeLocalMapPictures(out, maps.maps, args.threads);
+  io::writeLocalMapPictures(out, maps.maps, args.threads, io::groupColours(maps.topology));
 }
 
 /// The method's settings as partition.json records them.

@@ -11,8 +11,10 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <numeric>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace obsgroup::io {
 
@@ -22,13 +24,17 @@ struct Rgb {
   double r, g, b;
 };
 
-/// Well separated colours for the first groups, then golden-angle hues.
-Rgb groupColour(int group) {
+constexpr int kDistinctColours = 12;  ///< well separated colours of the palette
+constexpr int kArcsPerGroup = 3;      ///< map.png shows each group's strongest arcs
+
+/// Colour `index` of the palette: 12 well separated colours (no grey, which
+/// the arcs use), then golden-angle hues.
+Rgb paletteColour(int index) {
   static const Rgb kPalette[] = {{0.12, 0.47, 0.71}, {1.00, 0.50, 0.05}, {0.17, 0.63, 0.17}, {0.84, 0.15, 0.16},
-                                 {0.58, 0.40, 0.74}, {0.55, 0.34, 0.29}, {0.89, 0.47, 0.76}, {0.50, 0.50, 0.50},
-                                 {0.74, 0.74, 0.13}, {0.09, 0.75, 0.81}};
-  if (group < 10) return kPalette[group];
-  const double h = std::fmod(group * 0.618033988749895, 1.0) * 6.0;
+                                 {0.58, 0.40, 0.74}, {0.55, 0.34, 0.29}, {0.89, 0.47, 0.76}, {0.74, 0.74, 0.13},
+                                 {0.09, 0.75, 0.81}, {0.10, 0.15, 0.50}, {0.00, 0.50, 0.42}, {0.60, 0.00, 0.35}};
+  if (index < kDistinctColours) return kPalette[index];
+  const double h = std::fmod(index * 0.618033988749895, 1.0) * 6.0;
   const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
   const double c = 0.8, m = 0.1;
   const int sector = static_cast<int>(h);
@@ -36,8 +42,11 @@ Rgb groupColour(int group) {
   return {rgb[sector][0] * c + m, rgb[sector][1] * c + m, rgb[sector][2] * c + m};
 }
 
+Rgb darker(const Rgb& c) { return {c.r * 0.6, c.g * 0.6, c.b * 0.6}; }
+
 using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
 using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
+using View = PictureView;
 
 Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
@@ -50,25 +59,26 @@ void writePng(const OutputFolder& out, const std::string& name, cairo_surface_t*
   });
 }
 
-void text(cairo_t* cr, double x, double y, const std::string& s, double size = 14) {
+void setFont(cairo_t* cr, double size) {
   cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
   cairo_set_font_size(cr, size);
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, s.c_str());
 }
 
-/// World (re-centred) metres to picture pixels, y up.
-struct View {
-  double scale = 1.0, min_x = 0.0, max_y = 0.0, margin = 40.0;
-  int width = 0, height = 0;
-  double px(double x) const { return margin + (x - min_x) * scale; }
-  double py(double y) const { return margin + (max_y - y) * scale; }
-};
+/// Draws `s` from (x, y) (its baseline) and returns its width.
+double text(cairo_t* cr, double x, double y, const std::string& s, double size = 14) {
+  setFont(cr, size);
+  cairo_text_extents_t extents;
+  cairo_text_extents(cr, s.c_str(), &extents);
+  cairo_move_to(cr, x, y);
+  cairo_show_text(cr, s.c_str());
+  cairo_new_path(cr);
+  return extents.x_advance;
+}
 
 /// A view of `box` (at least 1 m a side) whose longer side is `longest`
-/// pixels, within the margin, with 20 px more below for a caption. A picture
-/// narrower than `min_width` is widened about the box.
-View fitView(Eigen::AlignedBox2d box, double longest, int min_width = 0) {
+/// pixels, within the margin, with `below` pixels more below for a caption or
+/// legend. A picture narrower than `min_width` is widened about the box.
+View fitView(Eigen::AlignedBox2d box, double longest, int min_width, int below) {
   if (box.isEmpty()) box.extend(Eigen::Vector2d::Zero());
   const Eigen::Vector2d size = box.sizes().cwiseMax(1.0);
   View v;
@@ -76,7 +86,7 @@ View fitView(Eigen::AlignedBox2d box, double longest, int min_width = 0) {
   v.min_x = box.min().x();
   v.max_y = box.max().y();
   v.width = static_cast<int>(std::ceil(size.x() * v.scale + 2 * v.margin));
-  v.height = static_cast<int>(std::ceil(size.y() * v.scale + 2 * v.margin + 20));
+  v.height = static_cast<int>(std::ceil(size.y() * v.scale + 2 * v.margin + below));
   if (v.width < min_width) {
     v.min_x -= (min_width - v.width) / 2.0 / v.scale;
     v.width = min_width;
@@ -84,22 +94,55 @@ View fitView(Eigen::AlignedBox2d box, double longest, int min_width = 0) {
   return v;
 }
 
-Eigen::AlignedBox2d boxOf(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
-                          const std::vector<Eigen::Vector2d>& positions) {
+/// The q- and (1-q)-quantiles of `values` (reordered).
+std::pair<double, double> quantiles(std::vector<float>& values, double q) {
+  const std::size_t lo = std::size_t(q * (values.size() - 1)), hi = values.size() - 1 - lo;
+  std::nth_element(values.begin(), values.begin() + lo, values.end());
+  const double low = values[lo];
+  std::nth_element(values.begin(), values.begin() + hi, values.end());
+  return {low, values[hi]};
+}
+
+/// The bulk of what is drawn: every position, and the points [begin, end)
+/// between the q- and (1-q)-quantiles on each axis (of at most 200000 of
+/// them, evenly spaced), grown on each side by 4% of its size on that axis
+/// (at least 1 m). A few far returns (through a window, a door) do not set
+/// the extent.
+Eigen::AlignedBox2d bulkBox(const Eigen::Vector3f* begin, const Eigen::Vector3f* end,
+                            const std::vector<Eigen::Vector2d>& positions, double q) {
   Eigen::AlignedBox2d box;
-  for (const Eigen::Vector3f* p = begin; p != end; ++p) box.extend(p->head<2>().cast<double>());
   for (const auto& p : positions) box.extend(p);
-  return box;
+  const std::size_t n = std::size_t(end - begin), step = std::max<std::size_t>(1, n / 200000);
+  if (n > 0) {
+    std::vector<float> xs, ys;
+    for (std::size_t k = 0; k < n; k += step) xs.push_back(begin[k].x()), ys.push_back(begin[k].y());
+    const auto [x0, x1] = quantiles(xs, q);
+    const auto [y0, y1] = quantiles(ys, q);
+    box.extend(Eigen::Vector2d(x0, y0));
+    box.extend(Eigen::Vector2d(x1, y1));
+  }
+  if (box.isEmpty()) return box;
+  const Eigen::Array2d grow = (0.04 * box.sizes().array()).max(1.0);
+  return Eigen::AlignedBox2d(box.min().array() - grow, box.max().array() + grow);
 }
 
 std::uint32_t argbOf(const Rgb& c) {
   return 0xff000000u | (std::uint32_t(c.r * 255) << 16) | (std::uint32_t(c.g * 255) << 8) | std::uint32_t(c.b * 255);
 }
 
+Rgb pale(const Rgb& c) { return {0.72 + 0.28 * c.r, 0.72 + 0.28 * c.g, 0.72 + 0.28 * c.b}; }
+
+/// Fills the `half`-pixel square about (cx, cy) of an image surface's pixels.
+void fillSquare(const View& v, int cx, int cy, int half, std::uint32_t argb, unsigned char* data, int stride) {
+  for (int y = std::max(0, cy - half); y < std::min(v.height, cy + half); ++y)
+    for (int x = std::max(0, cx - half); x < std::min(v.width, cx + half); ++x)
+      reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = argb;
+}
+
 /// Each region cell in a pale shade of the group most of whose observations
 /// hold it (ties: the lower group). Cells of 3D regions are seen from above.
-void tintRegions(const ObservationRegions& regions, const Partition& partition, const View& v, unsigned char* data,
-                 int stride) {
+void tintRegions(const ObservationRegions& regions, const Partition& partition, const std::vector<int>& colours,
+                 const View& v, unsigned char* data, int stride) {
   std::vector<std::pair<std::uint64_t, int>> cells;  // (plane cell, group)
   cells.reserve(regions.cells.size());
   for (int i = 0; i < regions.size(); ++i)
@@ -120,12 +163,8 @@ void tintRegions(const ObservationRegions& regions, const Partition& partition, 
       if (int(e - b) > best_count) best = cells[b].second, best_count = int(e - b);
       b = e;
     }
-    const Rgb g = groupColour(best);
-    const std::uint32_t pale = argbOf({0.72 + 0.28 * g.r, 0.72 + 0.28 * g.g, 0.72 + 0.28 * g.b});
     const int cx = int(std::int32_t(cells[a].first >> 32)), cy = int(std::int32_t(cells[a].first & 0xffffffffu));
-    for (int y = std::max(0, cy - half); y < std::min(v.height, cy + half); ++y)
-      for (int x = std::max(0, cx - half); x < std::min(v.width, cx + half); ++x)
-        reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = pale;
+    fillSquare(v, cx, cy, half, argbOf(pale(paletteColour(colours[best]))), data, stride);
     a = b;
   }
 }
@@ -134,29 +173,35 @@ void tintRegions(const ObservationRegions& regions, const Partition& partition, 
 int dotSize(std::size_t points) { return points < 300000 ? 2 : 1; }
 
 /// Points [begin, end) seen from above, `dot` pixels square each, into an
-/// image surface's pixels.
+/// image surface's pixels; those outside the picture are left out.
 void plotPoints(const View& v, const Eigen::Vector3f* begin, const Eigen::Vector3f* end, std::uint32_t argb, int dot,
                 unsigned char* data, int stride) {
   for (const Eigen::Vector3f* p = begin; p != end; ++p) {
-    const int x = static_cast<int>(v.px(p->x())), y = static_cast<int>(v.py(p->y()));
+    const double fx = v.px(p->x()), fy = v.py(p->y());
+    if (!(fx >= 0 && fy >= 0 && fx < v.width && fy < v.height)) continue;
+    const int x = static_cast<int>(fx), y = static_cast<int>(fy);
     for (int dy = 0; dy < dot; ++dy)
       for (int dx = 0; dx < dot; ++dx)
-        if (x + dx >= 0 && x + dx < v.width && y + dy >= 0 && y + dy < v.height)
+        if (x + dx < v.width && y + dy < v.height)
           reinterpret_cast<std::uint32_t*>(data + (y + dy) * stride)[x + dx] = argb;
   }
 }
 
-/// The points coloured by group over the tinted regions when there are some.
-Surface rasterPoints(const WorldPoints& world, const Partition& partition, const View& v,
+/// The points coloured by group over the tinted regions when there are some,
+/// on a transparent background above the legend.
+Surface rasterPoints(const WorldPoints& world, const Partition& partition, const MapLayout& layout,
                      const ObservationRegions* regions) {
+  View v = layout.view;
+  v.height = layout.legend_top;
   Surface surface = imageSurface(v.width, v.height);
   cairo_surface_flush(surface.get());
   unsigned char* data = cairo_image_surface_get_data(surface.get());
   const int stride = cairo_image_surface_get_stride(surface.get());
-  if (regions) tintRegions(*regions, partition, v, data, stride);
+  if (regions) tintRegions(*regions, partition, layout.colours, v, data, stride);
   const int dot = dotSize(world.points.size());
   for (int i = 0; i < world.size(); ++i)
-    plotPoints(v, world.begin(i), world.end(i), argbOf(groupColour(partition.group_of[i])), dot, data, stride);
+    plotPoints(v, world.begin(i), world.end(i), argbOf(paletteColour(layout.colours[partition.group_of[i]])), dot,
+               data, stride);
   cairo_surface_mark_dirty(surface.get());
   return surface;
 }
@@ -180,14 +225,14 @@ void planarPose(const Eigen::Isometry3d& pose, const Eigen::Vector3d& origin, Ei
   heading = std::atan2(ahead.y(), ahead.x());
 }
 
-/// A bar of a round length (1, 2 or 5 times a power of ten metres) at most a
-/// fifth of the drawing wide, labelled, in the top right margin.
-void drawScaleBar(cairo_t* cr, const View& v) {
-  const double most = (v.width - 2 * v.margin) / 5.0 / v.scale;
-  double length = std::pow(10.0, std::floor(std::log10(most)));
-  if (5 * length <= most) length *= 5;
-  else if (2 * length <= most) length *= 2;
-  const double pixels = length * v.scale, x1 = v.width - v.margin, x0 = x1 - pixels, y = v.margin / 2;
+/// A bar of a round length (1, 2 or 5 times a power of ten metres) at most
+/// `most` pixels long, labelled on its left, its right end at (x1, y).
+void drawScaleBar(cairo_t* cr, double scale, double most, double x1, double y) {
+  const double metres = most / scale;
+  double length = std::pow(10.0, std::floor(std::log10(metres)));
+  if (5 * length <= metres) length *= 5;
+  else if (2 * length <= metres) length *= 2;
+  const double x0 = x1 - length * scale;
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_set_line_width(cr, 2);
   cairo_new_path(cr);
@@ -199,67 +244,240 @@ void drawScaleBar(cairo_t* cr, const View& v) {
   char label[32];
   std::snprintf(label, sizeof label, "%g m", length);
   cairo_text_extents_t extents;
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, 12);
+  setFont(cr, 12);
   cairo_text_extents(cr, label, &extents);
   text(cr, x0 - extents.x_advance - 6, y + 4, label, 12);
 }
 
-void drawMap(cairo_t* cr, cairo_surface_t* points, const View& v, const std::vector<Eigen::Vector2d>& positions,
-             const std::vector<double>& headings, const Partition& partition, const TopologicalMap& topology) {
+constexpr int kLegendHeight = 90;  ///< map.png's legend band
+
+/// Sizes of map.png's marks, from the typical distance in pixels between a
+/// group centre and the nearest other one: a picture of 10 groups and one
+/// of 1,000 are both readable.
+struct MarkSizes {
+  double label_radius = 11, dot_radius = 5, arc_width = 3, arrow = 10, arrow_width = 1.5;
+};
+
+MarkSizes markSizes(const MapLayout& layout, std::size_t observations) {
+  const auto& c = layout.centres;
+  std::vector<double> nearest;
+  for (std::size_t a = 0; a < c.size(); ++a) {
+    double d = 1e300;
+    for (std::size_t b = 0; b < c.size(); ++b)
+      if (b != a) d = std::min(d, (c[a] - c[b]).norm());
+    if (c.size() > 1) nearest.push_back(d);
+  }
+  double spacing = 60;
+  if (!nearest.empty()) {
+    std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+    spacing = nearest[nearest.size() / 2];
+  }
+  MarkSizes s;
+  if (c.size() > 1000) s.label_radius = 13;  // room for four digits
+  s.dot_radius = std::clamp(0.3 * spacing, 2.5, 5.0);
+  s.arc_width = std::clamp(0.15 * spacing, 1.2, 3.5);
+  s.arrow = std::clamp(0.5 * layout.view.scale, 6.0, 12.0);
+  s.arrow_width = observations > 500 ? 1.0 : 1.5;
+  return s;
+}
+
+/// Centre of each group (mean of its members' positions), in pixels.
+std::vector<Eigen::Vector2d> groupCentres(const View& v, const std::vector<Eigen::Vector2d>& positions,
+                                          const Partition& partition) {
+  std::vector<Eigen::Vector2d> centres(partition.groups.size(), Eigen::Vector2d::Zero());
+  for (std::size_t g = 0; g < partition.groups.size(); ++g) {
+    for (int i : partition.groups[g]) centres[g] += positions[i];
+    centres[g] /= double(std::max<std::size_t>(1, partition.groups[g].size()));
+    centres[g] = Eigen::Vector2d(v.px(centres[g].x()), v.py(centres[g].y()));
+  }
+  return centres;
+}
+
+/// Each shown arc as a solid grey line between the group centres, thicker
+/// and darker for a larger cut weight (all alike when none overlaps).
+void drawArcs(cairo_t* cr, const MapLayout& layout, const TopologicalMap& topology, const MarkSizes& sizes) {
+  double strongest = 0.0;
+  for (std::size_t a : layout.shown_arcs) strongest = std::max(strongest, topology.arcs[a].weight);
+  for (std::size_t a : layout.shown_arcs) {
+    const TopologicalArc& arc = topology.arcs[a];
+    const double strength = strongest > 0.0 ? arc.weight / strongest : 0.0;
+    cairo_set_source_rgba(cr, 0.15, 0.15, 0.15, 0.6 + 0.3 * strength);
+    cairo_set_line_width(cr, std::max(1.2, sizes.arc_width * (0.3 + 0.7 * strength)));
+    cairo_move_to(cr, layout.centres[arc.from].x(), layout.centres[arc.from].y());
+    cairo_line_to(cr, layout.centres[arc.to].x(), layout.centres[arc.to].y());
+    cairo_stroke(cr);
+  }
+}
+
+/// Each pose as an arrow in a darker shade of its group's colour, but one
+/// within an arrow's length of the last drawn in its group left out.
+void drawPoses(cairo_t* cr, const MapLayout& layout, const std::vector<Eigen::Vector2d>& positions,
+               const std::vector<double>& headings, const Partition& partition, const MarkSizes& sizes) {
+  const View& v = layout.view;
+  std::vector<Eigen::Vector2d> last(partition.groups.size(), Eigen::Vector2d::Constant(-1e9));
+  cairo_set_line_width(cr, sizes.arrow_width);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const int g = partition.group_of[i];
+    const Eigen::Vector2d p(v.px(positions[i].x()), v.py(positions[i].y()));
+    if ((p - last[g]).norm() < sizes.arrow) continue;
+    last[g] = p;
+    const Rgb c = darker(paletteColour(layout.colours[g]));
+    cairo_set_source_rgb(cr, c.r, c.g, c.b);
+    arrowPath(cr, p.x(), p.y(), headings[i], sizes.arrow);
+    cairo_stroke(cr);
+  }
+}
+
+/// A group's mark: a white disc ringed in its colour holding its number, or
+/// (`label` false) a dot of its colour ringed dark.
+void groupMark(cairo_t* cr, double x, double y, int group, const Rgb& c, bool label, const MarkSizes& sizes) {
+  cairo_new_path(cr);
+  if (!label) {
+    cairo_arc(cr, x, y, sizes.dot_radius, 0, 2 * M_PI);
+    cairo_set_source_rgb(cr, c.r, c.g, c.b);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    cairo_set_line_width(cr, 1);
+    cairo_stroke(cr);
+    return;
+  }
+  const std::string number = std::to_string(group);
+  const double size = number.size() > 3 ? 10 : (number.size() > 2 ? 11 : 13);
+  cairo_arc(cr, x, y, sizes.label_radius, 0, 2 * M_PI);
+  cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
+  cairo_fill_preserve(cr);
+  cairo_set_source_rgb(cr, c.r, c.g, c.b);
+  cairo_set_line_width(cr, 2);
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  setFont(cr, size);
+  cairo_text_extents_t extents;
+  cairo_text_extents(cr, number.c_str(), &extents);
+  text(cr, x - extents.x_advance / 2, y + size * 0.36, number, size);
+}
+
+/// Which groups are numbered: where the numbers fit (the larger groups
+/// first, no two numbered circles overlapping, and when the groups are dense
+/// a circle's width apart so that the map shows between them).
+std::vector<char> numberedGroups(const std::vector<Eigen::Vector2d>& centres, const Partition& partition,
+                                 const MarkSizes& sizes) {
+  const double gap = (sizes.dot_radius < 5.0 ? 4 : 2) * sizes.label_radius + 1;
+  std::vector<int> order(partition.groups.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return partition.groups[a].size() > partition.groups[b].size(); });
+  std::vector<char> numbered(order.size(), 0);
+  std::vector<int> placed;
+  for (int g : order) {
+    bool fits = true;
+    for (int h : placed) fits = fits && (centres[g] - centres[h]).norm() >= gap;
+    if (fits) numbered[g] = 1, placed.push_back(g);
+  }
+  return numbered;
+}
+
+/// The groups' marks: numbered circles (MapLayout::numbered), dots elsewhere.
+void drawGroupMarks(cairo_t* cr, const MapLayout& layout, const MarkSizes& sizes) {
+  for (int pass = 0; pass < 2; ++pass)  // dots first, numbers on top
+    for (std::size_t g = 0; g < layout.centres.size(); ++g)
+      if (bool(layout.numbered[g]) == (pass == 1))
+        groupMark(cr, layout.centres[g].x(), layout.centres[g].y(), int(g), paletteColour(layout.colours[g]),
+                  layout.numbered[g], sizes);
+}
+
+/// What the legend says beside each mark.
+struct LegendText {
+  std::size_t observations = 0, groups = 0, numbered = 0, arcs = 0, shown_arcs = 0, outside = 0;
+  bool regions = false;
+};
+
+/// The legend's first row, at `row`: a group's circle, a dot (when some
+/// groups are not numbered), a pose's arrow; the scale bar on the right.
+void legendMarks(cairo_t* cr, const View& v, double row, const LegendText& t, const MarkSizes& sizes) {
+  const Rgb sample = paletteColour(0);
+  groupMark(cr, v.margin + 11, row, 7, sample, true, sizes);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  double x = v.margin + 28;
+  x += text(cr, x, row + 4, "group, at its observations' mean", 12) + 14;
+  if (t.numbered < t.groups) {
+    groupMark(cr, x + 5, row, 0, sample, false, sizes);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    x += 16 + text(cr, x + 14, row + 4, "group (no room for its number)", 12) + 14;
+  }
+  const Rgb arrow = darker(sample);
+  cairo_set_source_rgb(cr, arrow.r, arrow.g, arrow.b);
+  cairo_set_line_width(cr, 1.5);
+  arrowPath(cr, x, row, 0.0, 14);
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  text(cr, x + 20, row + 4, "observation pose (thinned where dense)", 12);
+  drawScaleBar(cr, v.scale, std::min(320.0, (v.width - 2 * v.margin) / 4.0), v.width - v.margin, row + 2);
+}
+
+/// The legend's second row, at `row`: an arc and which are shown, a tinted
+/// cell (with regions); then the counts.
+void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendText& t) {
+  const double x0 = v.margin;
+  cairo_set_source_rgba(cr, 0.15, 0.15, 0.15, 0.85);
+  cairo_set_line_width(cr, 3);
+  cairo_move_to(cr, x0, row);
+  cairo_line_to(cr, x0 + 22, row);
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  char arcs[200];
+  std::snprintf(arcs, sizeof arcs, "arc of the topology, thicker = larger cut weight: the %d strongest of each group"
+                " (%zu of %zu; all in topology.json)", kArcsPerGroup, t.shown_arcs, t.arcs);
+  const double x = x0 + 28 + text(cr, x0 + 28, row + 4, arcs, 12) + 14;
+  if (t.regions) {
+    const Rgb p = pale(paletteColour(0));
+    cairo_set_source_rgb(cr, p.r, p.g, p.b);
+    cairo_rectangle(cr, x, row - 6, 12, 12);
+    cairo_fill(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    text(cr, x + 18, row + 4, "space sensed, tinted by the group holding it most", 12);
+  }
+  char caption[240], outside[64] = "";
+  if (t.outside > 0)
+    std::snprintf(outside, sizeof outside, "; %zu far point%s outside the picture", t.outside,
+                  t.outside == 1 ? "" : "s");
+  std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered); neighbouring groups differ in"
+                " colour%s", t.observations, t.groups, t.numbered, outside);
+  text(cr, x0, row + 24, caption, 12);
+}
+
+/// The legend band below the drawing: one sample of each mark with what it
+/// means, a scale bar, and the counts.
+void drawLegend(cairo_t* cr, const MapLayout& layout, const LegendText& t, const MarkSizes& sizes) {
+  const View& v = layout.view;
+  cairo_set_source_rgb(cr, 0.96, 0.96, 0.96);
+  cairo_rectangle(cr, 0, layout.legend_top, v.width, v.height - layout.legend_top);
+  cairo_fill(cr);
+  legendMarks(cr, v, layout.legend_top + 18, t, sizes);
+  legendArcsAndCounts(cr, v, layout.legend_top + 40, t);
+}
+
+
+/// The picture over `points` (the rasterised points), without the legend.
+void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
+             const std::vector<Eigen::Vector2d>& positions, const std::vector<double>& headings,
+             const Partition& partition, const TopologicalMap& topology, bool regions) {
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
   cairo_set_source_surface(cr, points, 0, 0);
   cairo_paint(cr);
-  // Arcs of the topological map between the groups' mean positions.
-  std::vector<Eigen::Vector2d> centre(partition.groups.size(), Eigen::Vector2d::Zero());
-  for (std::size_t g = 0; g < partition.groups.size(); ++g) {
-    for (int i : partition.groups[g]) centre[g] += positions[i];
-    centre[g] /= double(partition.groups[g].size());
-  }
-  // Stronger arcs (larger cut weight) are drawn thicker and darker. Arcs of
-  // consecutive observations only weigh 0: when no arc overlaps, all are thin.
-  double strongest = 0.0;
-  for (const auto& arc : topology.arcs) strongest = std::max(strongest, arc.weight);
-  const double dash[] = {6.0, 4.0};
-  cairo_set_dash(cr, dash, 2, 0);
-  for (const auto& arc : topology.arcs) {
-    const double strength = strongest > 0.0 ? arc.weight / strongest : 0.0;
-    cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.15 + 0.6 * strength);
-    cairo_set_line_width(cr, 0.5 + 2.5 * strength);
-    cairo_move_to(cr, v.px(centre[arc.from].x()), v.py(centre[arc.from].y()));
-    cairo_line_to(cr, v.px(centre[arc.to].x()), v.py(centre[arc.to].y()));
-    cairo_stroke(cr);
-  }
-  cairo_set_dash(cr, nullptr, 0, 0);
-  // Poses as arrows.
-  const double length = std::max(10.0, 0.5 * v.scale);
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    const Rgb c = groupColour(partition.group_of[i]);
-    cairo_set_source_rgb(cr, c.r * 0.6, c.g * 0.6, c.b * 0.6);
-    cairo_set_line_width(cr, 1.5);
-    arrowPath(cr, v.px(positions[i].x()), v.py(positions[i].y()), headings[i], length);
-    cairo_stroke(cr);
-  }
-  // Group labels at their centres.
-  for (std::size_t g = 0; g < centre.size(); ++g) {
-    const double x = v.px(centre[g].x()), y = v.py(centre[g].y());
-    cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
-    cairo_new_path(cr);  // the previous label's text leaves a current point
-    cairo_arc(cr, x, y, 11, 0, 2 * M_PI);
-    cairo_fill_preserve(cr);
-    const Rgb c = groupColour(static_cast<int>(g));
-    cairo_set_source_rgb(cr, c.r, c.g, c.b);
-    cairo_set_line_width(cr, 2);
-    cairo_stroke(cr);
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    text(cr, x - (g < 10 ? 4 : 8), y + 5, std::to_string(g), 13);
-  }
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  char caption[160];
-  std::snprintf(caption, sizeof caption, "%zu observations, %zu groups, %zu arcs; 1 m = %.1f px",
-                positions.size(), partition.groups.size(), topology.arcs.size(), v.scale);
-  text(cr, v.margin, v.height - 12, caption);
+  const MarkSizes sizes = markSizes(layout, positions.size());
+  drawArcs(cr, layout, topology, sizes);
+  drawPoses(cr, layout, positions, headings, partition, sizes);
+  drawGroupMarks(cr, layout, sizes);
+  LegendText legend;
+  legend.numbered = std::size_t(std::count(layout.numbered.begin(), layout.numbered.end(), 1));
+  legend.observations = positions.size();
+  legend.groups = partition.groups.size();
+  legend.arcs = topology.arcs.size();
+  legend.shown_arcs = layout.shown_arcs.size();
+  legend.outside = layout.points_outside;
+  legend.regions = regions;
+  drawLegend(cr, layout, legend, sizes);
 }
 
 /// The points of `world`, at the input `poses`, moved to the `drawn` poses:
@@ -282,30 +500,55 @@ WorldPoints atDrawnPoses(const WorldPoints& world, const std::vector<Eigen::Isom
   return moved;
 }
 
-/// One local map from above in its own frame: its points (already in
-/// `surface`), its members' poses, the reference's black in a ring.
-void drawLocalMap(cairo_t* cr, const View& v, int group, const LocalMapFrame& frame, std::size_t points) {
-  const Rgb c = groupColour(group);
+/// The layout of the map of `world` (already at the drawn poses) whose
+/// observations are at `positions` (re-centred like `world`).
+MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions,
+                   const Partition& partition, const TopologicalMap& topology) {
+  MapLayout layout;
+  const Eigen::AlignedBox2d box =
+      bulkBox(world.points.data(), world.points.data() + world.points.size(), positions, 0.025);
+  // A larger picture for many groups, so that they keep some room each.
+  const double longest = std::clamp(1600.0 * std::sqrt(partition.groups.size() / 200.0), 1600.0, 2800.0);
+  layout.view = fitView(box, longest, 1100, kLegendHeight);
+  layout.legend_top = layout.view.height - kLegendHeight;
+  layout.centres = groupCentres(layout.view, positions, partition);
+  layout.colours = groupColours(topology);
+  layout.colours.resize(partition.groups.size(), 0);  // a topology of other groups
+  layout.shown_arcs = shownArcs(topology, kArcsPerGroup);
+  const MarkSizes sizes = markSizes(layout, positions.size());
+  layout.label_radius = sizes.label_radius;
+  layout.numbered = numberedGroups(layout.centres, partition, sizes);
+  for (const Eigen::Vector3f& p : world.points) {
+    const double x = layout.view.px(p.x()), y = layout.view.py(p.y());
+    layout.points_outside += !(x >= 0 && y >= 0 && x < layout.view.width && y < layout.legend_top);
+  }
+  return layout;
+}
+
+void planarPoses(const std::vector<Eigen::Isometry3d>& drawn, const Eigen::Vector3d& origin,
+                 std::vector<Eigen::Vector2d>& positions, std::vector<double>& headings) {
+  positions.resize(drawn.size());
+  headings.resize(drawn.size());
+  for (std::size_t i = 0; i < drawn.size(); ++i) planarPose(drawn[i], origin, positions[i], headings[i]);
+}
+
+/// Each member's pose as an arrow in a darker shade of `c`, the reference's
+/// black and longer, in a ring.
+void drawMemberPoses(cairo_t* cr, const View& v, const LocalMapFrame& frame, const Rgb& c) {
   const double length = std::clamp(0.5 * v.scale, 10.0, 30.0);
-  std::size_t reference = 0;
   for (std::size_t k = 0; k < frame.members.size(); ++k) {
-    if (frame.members[k] == frame.reference) {
-      reference = k;
-      continue;
-    }
     Eigen::Vector2d position;
     double heading;
     planarPose(frame.member_poses[k], Eigen::Vector3d::Zero(), position, heading);
-    cairo_set_source_rgb(cr, c.r * 0.6, c.g * 0.6, c.b * 0.6);
-    cairo_set_line_width(cr, 1.5);
-    arrowPath(cr, v.px(position.x()), v.py(position.y()), heading, length);
-    cairo_stroke(cr);
-  }
-  if (!frame.members.empty()) {
-    Eigen::Vector2d position;
-    double heading;
-    planarPose(frame.member_poses[reference], Eigen::Vector3d::Zero(), position, heading);
     const double x = v.px(position.x()), y = v.py(position.y());
+    if (frame.members[k] != frame.reference) {
+      const Rgb d = darker(c);
+      cairo_set_source_rgb(cr, d.r, d.g, d.b);
+      cairo_set_line_width(cr, 1.5);
+      arrowPath(cr, x, y, heading, length);
+      cairo_stroke(cr);
+      continue;
+    }
     cairo_set_source_rgb(cr, 0, 0, 0);
     cairo_set_line_width(cr, 2.5);
     arrowPath(cr, x, y, heading, 1.3 * length);
@@ -315,36 +558,125 @@ void drawLocalMap(cairo_t* cr, const View& v, int group, const LocalMapFrame& fr
     cairo_set_line_width(cr, 2);
     cairo_stroke(cr);
   }
-  drawScaleBar(cr, v);
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  char caption[200];
-  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; reference %d (black)", group,
-                frame.members.size(), points, frame.reference);
-  text(cr, v.margin, v.height - 12, caption, 12);
 }
 
 /// local_maps/group_NNN.png of one local map, whose points (in its frame)
 /// are given without the non-finite ones.
 void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFrame& frame,
-                          const std::vector<Eigen::Vector3f>& points) {
+                          const std::vector<Eigen::Vector3f>& points, const Rgb& colour) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
   for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
-  const View v = fitView(boxOf(points.data(), points.data() + points.size(), positions), 700.0, 480);
+  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions, 0.005), 700.0, 520, 20);
   Surface surface = imageSurface(v.width, v.height);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
   cairo_paint(cr.get());
   cairo_surface_flush(surface.get());
-  plotPoints(v, points.data(), points.data() + points.size(), argbOf(groupColour(group)), dotSize(points.size()),
+  plotPoints(v, points.data(), points.data() + points.size(), argbOf(colour), dotSize(points.size()),
              cairo_image_surface_get_data(surface.get()), cairo_image_surface_get_stride(surface.get()));
   cairo_surface_mark_dirty(surface.get());
-  drawLocalMap(cr.get(), v, group, frame, points.size());
+  drawMemberPoses(cr.get(), v, frame, colour);
+  drawScaleBar(cr.get(), v.scale, (v.width - 2 * v.margin) / 5.0, v.width - v.margin, v.margin / 2);
+  cairo_set_source_rgb(cr.get(), 0, 0, 0);
+  char caption[200];
+  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; ringed: reference %d",
+                group, frame.members.size(), points.size(), frame.reference);
+  text(cr.get(), v.margin, v.height - 12, caption, 12);
   char name[64];
   std::snprintf(name, sizeof name, "local_maps/group_%03d.png", group);
   writePng(out, name, surface.get());
 }
 
+/// Neighbours of each node, ascending: joined by one of `arcs` (indices into
+/// topology.arcs), or among each other's two nearest centres (the mean of
+/// the members' global poses).
+std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology, const std::vector<std::size_t>& arcs) {
+  const int n = static_cast<int>(topology.nodes.size());
+  std::vector<std::vector<int>> neighbours(n);
+  for (std::size_t a : arcs) {
+    const TopologicalArc& arc = topology.arcs[a];
+    if (arc.from >= 0 && arc.to < n) neighbours[arc.from].push_back(arc.to), neighbours[arc.to].push_back(arc.from);
+  }
+  std::vector<Eigen::Vector3d> centre(n, Eigen::Vector3d::Zero());
+  for (int g = 0; g < n; ++g) {
+    const LocalMapFrame& node = topology.nodes[g];
+    for (const auto& member : node.member_poses) centre[g] += (node.pose * member).translation();
+    centre[g] /= double(std::max<std::size_t>(1, node.member_poses.size()));
+  }
+  for (int g = 0; g < n; ++g) {
+    std::vector<std::pair<double, int>> by_distance;
+    for (int h = 0; h < n; ++h)
+      if (h != g) by_distance.emplace_back((centre[g] - centre[h]).squaredNorm(), h);
+    const std::size_t k = std::min<std::size_t>(2, by_distance.size());
+    std::partial_sort(by_distance.begin(), by_distance.begin() + k, by_distance.end());
+    for (std::size_t j = 0; j < k; ++j)
+      neighbours[g].push_back(by_distance[j].second), neighbours[by_distance[j].second].push_back(g);
+  }
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
+
+/// A greedy colouring (DSATUR: next the node whose neighbours hold the most
+/// distinct colours, then the most neighbours, then the lowest index; the
+/// smallest colour none of them holds).
+std::vector<int> colourGraph(const std::vector<std::vector<int>>& neighbours) {
+  const int n = static_cast<int>(neighbours.size());
+  std::vector<int> colour(n, -1);
+  std::vector<std::vector<char>> seen(n);  // colours held by each node's neighbours
+  std::vector<int> saturation(n, 0);
+  for (int step = 0; step < n; ++step) {
+    int next = -1;
+    for (int g = 0; g < n; ++g)
+      if (colour[g] < 0 && (next < 0 || std::make_pair(saturation[g], neighbours[g].size()) >
+                                            std::make_pair(saturation[next], neighbours[next].size())))
+        next = g;
+    const auto free = std::find(seen[next].begin(), seen[next].end(), 0);
+    colour[next] = int(free - seen[next].begin());
+    for (int h : neighbours[next]) {
+      if (seen[h].size() <= std::size_t(colour[next])) seen[h].resize(colour[next] + 1, 0);
+      if (!seen[h][colour[next]]) seen[h][colour[next]] = 1, ++saturation[h];
+    }
+  }
+  return colour;
+}
+
 }  // namespace
+
+std::vector<int> groupColours(const TopologicalMap& topology) {
+  std::vector<std::size_t> all(topology.arcs.size());
+  std::iota(all.begin(), all.end(), std::size_t(0));
+  std::vector<int> colours = colourGraph(groupNeighbours(topology, all));
+  if (!colours.empty() && *std::max_element(colours.begin(), colours.end()) >= kDistinctColours)
+    colours = colourGraph(groupNeighbours(topology, shownArcs(topology, kArcsPerGroup)));
+  return colours;
+}
+
+std::vector<std::size_t> shownArcs(const TopologicalMap& topology, int per_node) {
+  const auto stronger = [&](std::size_t a, std::size_t b) {
+    const TopologicalArc &x = topology.arcs[a], &y = topology.arcs[b];
+    return std::tie(x.weight, x.overlapping_pairs, x.sequence_pairs) >
+           std::tie(y.weight, y.overlapping_pairs, y.sequence_pairs);
+  };
+  std::vector<std::vector<std::size_t>> of(topology.nodes.size());
+  for (std::size_t a = 0; a < topology.arcs.size(); ++a) {
+    const TopologicalArc& arc = topology.arcs[a];
+    for (int node : {arc.from, arc.to})
+      if (node >= 0 && std::size_t(node) < of.size()) of[node].push_back(a);
+  }
+  std::vector<char> shown(topology.arcs.size(), 0);
+  for (auto& arcs : of) {
+    const std::size_t k = std::min<std::size_t>(std::max(0, per_node), arcs.size());
+    std::partial_sort(arcs.begin(), arcs.begin() + k, arcs.end(), stronger);
+    for (std::size_t j = 0; j < k; ++j) shown[arcs[j]] = 1;
+  }
+  std::vector<std::size_t> result;
+  for (std::size_t a = 0; a < shown.size(); ++a)
+    if (shown[a]) result.push_back(a);
+  return result;
+}
 
 std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std::size_t observations) {
   std::vector<Eigen::Isometry3d> poses(observations, Eigen::Isometry3d::Identity());
@@ -354,7 +686,8 @@ std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std:
 }
 
 template <typename PointT>
-void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads) {
+void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads,
+                           const std::vector<int>& colours) {
   const int n = static_cast<int>(maps.size());
   std::vector<std::exception_ptr> failures(maps.size());
 #pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 1)
@@ -366,7 +699,8 @@ void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<P
         for (const PointT& p : maps[g].cloud->points)
           if (std::isfinite(p.x) && std::isfinite(p.y)) points.emplace_back(p.x, p.y, p.z);
       }
-      writeLocalMapPicture(out, g, maps[g].frame, points);
+      const int colour = std::size_t(g) < colours.size() ? colours[g] : g;
+      writeLocalMapPicture(out, g, maps[g].frame, points, paletteColour(colour));
     } catch (...) {
       failures[g] = std::current_exception();
     }
@@ -375,39 +709,105 @@ void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<P
     if (failure) std::rethrow_exception(failure);
 }
 
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int);
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&, int);
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int);
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int,
+                                    const std::vector<int>&);
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&, int,
+                                    const std::vector<int>&);
+template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int,
+                                    const std::vector<int>&);
+
+MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
+                    const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
+                    const TopologicalMap& topology) {
+  std::vector<Eigen::Vector2d> positions;
+  std::vector<double> headings;
+  planarPoses(drawn, world.origin, positions, headings);
+  return layoutOf(atDrawnPoses(world, poses, drawn), positions, partition, topology);
+}
 
 void writeMapPictures(const OutputFolder& out, const WorldPoints& input_world,
                       const std::vector<Eigen::Isometry3d>& poses, const std::vector<Eigen::Isometry3d>& drawn,
                       const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
   const WorldPoints world = atDrawnPoses(input_world, poses, drawn);
-  std::vector<Eigen::Vector2d> positions(drawn.size());
-  std::vector<double> headings(drawn.size());
-  for (std::size_t i = 0; i < drawn.size(); ++i) planarPose(drawn[i], world.origin, positions[i], headings[i]);
-  const View v = fitView(boxOf(world.points.data(), world.points.data() + world.points.size(), positions), 1600.0);
+  std::vector<Eigen::Vector2d> positions;
+  std::vector<double> headings;
+  planarPoses(drawn, world.origin, positions, headings);
+  const MapLayout layout = layoutOf(world, positions, partition, topology);
   // The regions describe the input poses (they gave W) and stay there.
-  const Surface points = rasterPoints(world, partition, v, regions);
-
-  Surface png = imageSurface(v.width, v.height);
-  {
-    Context cr(cairo_create(png.get()), cairo_destroy);
-    drawMap(cr.get(), points.get(), v, positions, headings, partition, topology);
-  }
+  const Surface points = rasterPoints(world, partition, layout, regions);
+  const auto draw = [&](cairo_surface_t* target) {
+    Context cr(cairo_create(target), cairo_destroy);
+    drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr);
+  };
+  Surface png = imageSurface(layout.view.width, layout.view.height);
+  draw(png.get());
   writePng(out, "map.png", png.get());
-
   out.write("map.svg", [&](const std::string& temporary) {
-    Surface svg(cairo_svg_surface_create(temporary.c_str(), v.width, v.height), cairo_surface_destroy);
-    {
-      Context cr(cairo_create(svg.get()), cairo_destroy);
-      drawMap(cr.get(), points.get(), v, positions, headings, partition, topology);
-    }
+    Surface svg(cairo_svg_surface_create(temporary.c_str(), layout.view.width, layout.view.height),
+                cairo_surface_destroy);
+    draw(svg.get());
     cairo_surface_finish(svg.get());
     if (cairo_surface_status(svg.get()) != CAIRO_STATUS_SUCCESS)
       throw std::runtime_error(temporary + ": cairo cannot write the SVG");
   });
 }
+
+namespace {
+
+/// The darkness (W, at most 1) of each pixel of a `side`-pixel square
+/// picture of W whose rows and columns are at `position` (order by group).
+std::vector<float> weightDarkness(const WeightMatrix& W, const std::vector<int>& position, int side) {
+  const double cell = double(side) / W.rows();
+  std::vector<float> darkness(std::size_t(side) * side, 0.0f);
+  for (int col = 0; col < W.outerSize(); ++col)
+    for (WeightMatrix::InnerIterator it(W, col); it; ++it) {
+      const int x0 = int(position[col] * cell), y0 = int(position[it.row()] * cell);
+      const int x1 = std::max(x0 + 1, int((position[col] + 1) * cell));
+      const int y1 = std::max(y0 + 1, int((position[it.row()] + 1) * cell));
+      for (int y = y0; y < std::min(y1, side); ++y)
+        for (int x = x0; x < std::min(x1, side); ++x) {
+          float& d = darkness[std::size_t(y) * side + x];
+          d = std::max(d, static_cast<float>(std::min(1.0, it.value())));
+        }
+    }
+  return darkness;
+}
+
+/// One split's eigenvector in the `w` x `h` box at (ox, oy), its threshold
+/// in red, titled.
+void drawFiedlerPlot(cairo_t* cr, const SplitNode& node, int index, double ox, double oy, double w, double h) {
+  const Eigen::VectorXd& y = node.eigenvector;
+  double lo = std::min(y.minCoeff(), node.threshold), hi = std::max(y.maxCoeff(), node.threshold);
+  if (hi - lo < 1e-12) hi = lo + 1.0;
+  const auto sx = [&](double i) { return ox + (y.size() > 1 ? i / (y.size() - 1) : 0.5) * w; };
+  const auto sy = [&](double value) { return oy + h - (value - lo) / (hi - lo) * h; };
+  cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+  cairo_set_line_width(cr, 1);
+  cairo_rectangle(cr, ox, oy, w, h);
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0.12, 0.47, 0.71);
+  cairo_set_line_width(cr, 1.2);
+  for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr, sx(i), sy(y[i]));
+  cairo_stroke(cr);
+  for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
+    cairo_new_path(cr);
+    cairo_arc(cr, sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
+    cairo_fill(cr);
+  }
+  cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+  cairo_move_to(cr, ox, sy(node.threshold));
+  cairo_line_to(cr, ox + w, sy(node.threshold));
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  char title[200];
+  std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", index, node.members.size(), node.ncut,
+                node.accepted ? "accepted" : "rejected");
+  text(cr, ox, oy - 12, title);
+  text(cr, ox, oy + h + 20, "observation " + std::to_string(node.members.front()) + " ... " +
+                                std::to_string(node.members.back()) + " (in order); red: threshold", 12);
+}
+
+}  // namespace
 
 void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const Partition& partition) {
   const int n = static_cast<int>(W.rows());
@@ -424,18 +824,7 @@ void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const P
   const int side = n <= 800 ? n * std::max(1, 800 / n) : 800;
   const double cell = double(side) / n;
   const int margin = 30;
-  std::vector<float> darkness(std::size_t(side) * side, 0.0f);
-  for (int col = 0; col < W.outerSize(); ++col)
-    for (WeightMatrix::InnerIterator it(W, col); it; ++it) {
-      const int x0 = int(position[col] * cell), y0 = int(position[it.row()] * cell);
-      const int x1 = std::max(x0 + 1, int((position[col] + 1) * cell));
-      const int y1 = std::max(y0 + 1, int((position[it.row()] + 1) * cell));
-      for (int y = y0; y < std::min(y1, side); ++y)
-        for (int x = x0; x < std::min(x1, side); ++x) {
-          float& d = darkness[std::size_t(y) * side + x];
-          d = std::max(d, static_cast<float>(std::min(1.0, it.value())));
-        }
-    }
+  const std::vector<float> darkness = weightDarkness(W, position, side);
   Surface surface = imageSurface(side + 2 * margin, side + 2 * margin);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
@@ -480,40 +869,9 @@ void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
     cairo_set_source_rgb(cr.get(), 0, 0, 0);
     text(cr.get(), 20, 40, "No spectral bisection was computed (too few or no overlapping observations).");
   }
-  for (std::size_t k = 0; k < shown.size(); ++k) {
-    const SplitNode& node = *shown[k];
-    const double ox = (k % 2) * plot_w + 50, oy = (k / 2) * plot_h + 40;
-    const double w = plot_w - 80, h = plot_h - 80;
-    const Eigen::VectorXd& y = node.eigenvector;
-    double lo = std::min(y.minCoeff(), node.threshold), hi = std::max(y.maxCoeff(), node.threshold);
-    if (hi - lo < 1e-12) hi = lo + 1.0;
-    const auto sx = [&](double i) { return ox + (y.size() > 1 ? i / (y.size() - 1) : 0.5) * w; };
-    const auto sy = [&](double value) { return oy + h - (value - lo) / (hi - lo) * h; };
-    cairo_set_source_rgb(cr.get(), 0.3, 0.3, 0.3);
-    cairo_set_line_width(cr.get(), 1);
-    cairo_rectangle(cr.get(), ox, oy, w, h);
-    cairo_stroke(cr.get());
-    cairo_set_source_rgb(cr.get(), 0.12, 0.47, 0.71);
-    cairo_set_line_width(cr.get(), 1.2);
-    for (Eigen::Index i = 0; i < y.size(); ++i) (i ? cairo_line_to : cairo_move_to)(cr.get(), sx(i), sy(y[i]));
-    cairo_stroke(cr.get());
-    for (Eigen::Index i = 0; i < y.size() && y.size() <= 400; ++i) {
-      cairo_new_path(cr.get());
-      cairo_arc(cr.get(), sx(i), sy(y[i]), 2.5, 0, 2 * M_PI);
-      cairo_fill(cr.get());
-    }
-    cairo_set_source_rgb(cr.get(), 0.85, 0.1, 0.1);
-    cairo_move_to(cr.get(), ox, sy(node.threshold));
-    cairo_line_to(cr.get(), ox + w, sy(node.threshold));
-    cairo_stroke(cr.get());
-    cairo_set_source_rgb(cr.get(), 0, 0, 0);
-    char title[200];
-    std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", int(&node - partition.splits.data()),
-                  node.members.size(), node.ncut, node.accepted ? "accepted" : "rejected");
-    text(cr.get(), ox, oy - 12, title);
-    text(cr.get(), ox, oy + h + 20, "observation " + std::to_string(node.members.front()) + " ... " +
-                                        std::to_string(node.members.back()) + " (in order); red: threshold", 12);
-  }
+  for (std::size_t k = 0; k < shown.size(); ++k)
+    drawFiedlerPlot(cr.get(), *shown[k], int(shown[k] - partition.splits.data()), (k % 2) * plot_w + 50,
+                    (k / 2) * plot_h + 40, plot_w - 80, plot_h - 80);
   writePng(out, "fiedler.png", surface.get());
 }
 
