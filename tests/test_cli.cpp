@@ -206,6 +206,22 @@ TEST_F(Cli, OfficeLogEndToEnd) {
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json p = expectPartitionSchema(dir_ / "out", 77);
   expectAllOutputs(dir_ / "out", p);
+
+  // The README's sample is this run (scripts/readme-partition-sample.py):
+  // its statistics, parameters and first groups are what the run gives.
+  const std::string readme = readFile(fs::path(kData).parent_path() / "README.md");
+  const std::size_t begin = readme.find("<!-- partition-json:begin -->");
+  ASSERT_NE(begin, std::string::npos);
+  const auto sampleObject = [&](const std::string& key) {
+    const std::size_t at = readme.find("\"" + key + "\": {", begin);
+    const std::size_t open = readme.find('{', at), close = readme.find("},\n", open);
+    return nlohmann::json::parse(readme.substr(open, close + 1 - open));
+  };
+  EXPECT_EQ(sampleObject("statistics"), p.at("statistics")) << "regenerate with scripts/readme-partition-sample.py";
+  EXPECT_EQ(sampleObject("parameters"), p.at("parameters")) << "regenerate with scripts/readme-partition-sample.py";
+  std::string first_group = "\"groups\": [[";
+  for (const auto& i : p.at("groups")[0]) first_group += std::to_string(i.get<int>()) + ", ";
+  EXPECT_NE(readme.find(first_group.substr(0, first_group.size() - 2) + "]", begin), std::string::npos);
   EXPECT_EQ(p.at("parameters").at("laser"), "robotlaser");
   EXPECT_NE(r.err.find("77 observations"), std::string::npos) << r.err;
 
