@@ -49,74 +49,98 @@ void refuseHeaderAfterData(std::ifstream& in, const std::string& path, std::size
   in.seekg(start);
 }
 
-Header readHeader(std::ifstream& in, const std::string& path) {
+/// The header read so far, with the per-field lists checked against FIELDS.
+struct HeaderInProgress {
   Header h;
   std::vector<long> sizes, counts;
-  std::string line;
   std::set<std::string> seen;
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
-    if (number > 64) throw InputError(path + ": no DATA line in the first 64 lines: not a PCD header");
-    const auto f = splitFields(line);
-    if (f.empty() || f[0].front() == '#') continue;
-    const LineRef where{path, number};
-    const std::string key(f[0]);
-    if (!seen.insert(key).second) throw inputError(path, number, "field '" + key + "' appears twice in the header");
-    if (key == "VERSION") continue;
-    if (key == "FIELDS") {
-      h.fields = f.size() - 1;
-      if (h.fields == 0) throw inputError(path, number, "field 'FIELDS' lists no field");
-    } else if (key == "SIZE") {
-      checkCounts(f, h, where);
-      for (std::size_t k = 1; k < f.size(); ++k) {
-        const long s = parseCount(f[k], where, "SIZE", 8);
-        if (s != 1 && s != 2 && s != 4 && s != 8) throw inputError(path, number, "field 'SIZE': " + std::to_string(s) + " is not 1, 2, 4 or 8");
-        sizes.push_back(s);
-      }
-    } else if (key == "TYPE") {
-      checkCounts(f, h, where);
-      for (std::size_t k = 1; k < f.size(); ++k) {
-        if (f[k] != "F" && f[k] != "I" && f[k] != "U")
-          throw inputError(path, number, "field 'TYPE': '" + std::string(f[k]) + "' is not F, I or U");
-        if (f[k] == "F" && k <= sizes.size() && sizes[k - 1] != 4 && sizes[k - 1] != 8)
-          throw inputError(path, number, "field 'TYPE': F (float) with SIZE " + std::to_string(sizes[k - 1]) +
-                                             ": floats are 4 or 8 bytes");
-      }
-    } else if (key == "COUNT") {
-      checkCounts(f, h, where);
-      for (std::size_t k = 1; k < f.size(); ++k) {
-        counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
-        // PCL reads past the data of a field counted 0 (found by fuzzing).
-        if (counts.back() == 0) throw inputError(path, number, "field 'COUNT': a field counted 0 holds no value");
-      }
-    } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
-      if (f.size() != 2) throw inputError(path, number, "field '" + key + "' needs one value");
-      const long v = parseCount(f[1], where, key, 1L << 40);
-      (key == "WIDTH" ? h.width : key == "HEIGHT" ? h.height : h.points) = v;
-    } else if (key == "VIEWPOINT") {
-      if (f.size() != 8) throw inputError(path, number, "field 'VIEWPOINT' needs 7 values (tx ty tz qw qx qy qz)");
-      for (std::size_t k = 1; k < 8; ++k) parseFinite(f[k], where, "VIEWPOINT");
-    } else if (key == "DATA") {
-      if (f.size() != 2 || (f[1] != "ascii" && f[1] != "binary" && f[1] != "binary_compressed"))
-        throw inputError(path, number, "field 'DATA' must be ascii, binary or binary_compressed");
-      h.data = std::string(f[1]);
-      std::streampos after = in.tellg();
-      if (after < 0) {  // DATA was the last line, with no newline: no data
-        in.clear();
-        in.seekg(0, std::ios::end);
-        after = in.tellg();
-      }
-      h.data_offset = static_cast<std::size_t>(after);
-      refuseHeaderAfterData(in, path, number);
-      break;
-    } else {
-      throw inputError(path, number, "unknown header field '" + key + "': not a PCD header");
-    }
+};
+
+void readSizes(const std::vector<std::string_view>& f, HeaderInProgress& r, const LineRef& where) {
+  checkCounts(f, r.h, where);
+  for (std::size_t k = 1; k < f.size(); ++k) {
+    const long s = parseCount(f[k], where, "SIZE", 8);
+    if (s != 1 && s != 2 && s != 4 && s != 8)
+      throw inputError(where.file, where.line, "field 'SIZE': " + std::to_string(s) + " is not 1, 2, 4 or 8");
+    r.sizes.push_back(s);
   }
+}
+
+void readTypes(const std::vector<std::string_view>& f, const HeaderInProgress& r, const LineRef& where) {
+  checkCounts(f, r.h, where);
+  for (std::size_t k = 1; k < f.size(); ++k) {
+    if (f[k] != "F" && f[k] != "I" && f[k] != "U")
+      throw inputError(where.file, where.line, "field 'TYPE': '" + std::string(f[k]) + "' is not F, I or U");
+    if (f[k] == "F" && k <= r.sizes.size() && r.sizes[k - 1] != 4 && r.sizes[k - 1] != 8)
+      throw inputError(where.file, where.line, "field 'TYPE': F (float) with SIZE " + std::to_string(r.sizes[k - 1]) +
+                                                   ": floats are 4 or 8 bytes");
+  }
+}
+
+void readCounts(const std::vector<std::string_view>& f, HeaderInProgress& r, const LineRef& where) {
+  checkCounts(f, r.h, where);
+  for (std::size_t k = 1; k < f.size(); ++k) {
+    r.counts.push_back(parseCount(f[k], where, "COUNT", 1 << 20));
+    // PCL reads past the data of a field counted 0 (found by fuzzing).
+    if (r.counts.back() == 0) throw inputError(where.file, where.line, "field 'COUNT': a field counted 0 holds no value");
+  }
+}
+
+/// DATA ends the header: where the data start, once nothing header-like follows.
+void readData(const std::vector<std::string_view>& f, Header& h, std::ifstream& in, const LineRef& where) {
+  if (f.size() != 2 || (f[1] != "ascii" && f[1] != "binary" && f[1] != "binary_compressed"))
+    throw inputError(where.file, where.line, "field 'DATA' must be ascii, binary or binary_compressed");
+  h.data = std::string(f[1]);
+  std::streampos after = in.tellg();
+  if (after < 0) {  // DATA was the last line, with no newline: no data
+    in.clear();
+    in.seekg(0, std::ios::end);
+    after = in.tellg();
+  }
+  h.data_offset = static_cast<std::size_t>(after);
+  refuseHeaderAfterData(in, where.file, where.line);
+}
+
+/// One header line; returns false once DATA is read.
+bool readHeaderLine(const std::vector<std::string_view>& f, HeaderInProgress& r, std::ifstream& in,
+                    const LineRef& where) {
+  const std::string key(f[0]);
+  if (!r.seen.insert(key).second) throw inputError(where.file, where.line, "field '" + key + "' appears twice in the header");
+  if (key == "VERSION") return true;
+  if (key == "FIELDS") {
+    r.h.fields = f.size() - 1;
+    if (r.h.fields == 0) throw inputError(where.file, where.line, "field 'FIELDS' lists no field");
+  } else if (key == "SIZE") {
+    readSizes(f, r, where);
+  } else if (key == "TYPE") {
+    readTypes(f, r, where);
+  } else if (key == "COUNT") {
+    readCounts(f, r, where);
+  } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+    if (f.size() != 2) throw inputError(where.file, where.line, "field '" + key + "' needs one value");
+    const long v = parseCount(f[1], where, key, 1L << 40);
+    (key == "WIDTH" ? r.h.width : key == "HEIGHT" ? r.h.height : r.h.points) = v;
+  } else if (key == "VIEWPOINT") {
+    if (f.size() != 8) throw inputError(where.file, where.line, "field 'VIEWPOINT' needs 7 values (tx ty tz qw qx qy qz)");
+    for (std::size_t k = 1; k < 8; ++k) parseFinite(f[k], where, "VIEWPOINT");
+  } else if (key == "DATA") {
+    readData(f, r.h, in, where);
+    return false;
+  } else {
+    throw inputError(where.file, where.line, "unknown header field '" + key + "': not a PCD header");
+  }
+  return true;
+}
+
+/// The header as a whole: every required line there, the point size, and
+/// POINTS = WIDTH * HEIGHT.
+Header completeHeader(HeaderInProgress& r, const std::string& path) {
+  Header& h = r.h;
   if (h.data.empty()) throw InputError(path + ": the PCD header has no DATA line");
   for (const char* required : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT"})
-    if (!seen.count(required)) throw InputError(path + ": the PCD header has no " + required + " line");
-  if (counts.empty()) counts.assign(h.fields, 1);
-  for (std::size_t k = 0; k < h.fields; ++k) h.point_size += std::size_t(sizes[k] * counts[k]);
+    if (!r.seen.count(required)) throw InputError(path + ": the PCD header has no " + required + " line");
+  if (r.counts.empty()) r.counts.assign(h.fields, 1);
+  for (std::size_t k = 0; k < h.fields; ++k) h.point_size += std::size_t(r.sizes[k] * r.counts[k]);
   constexpr long kMaxPoints = 1L << 40;
   if (h.height > 0 && h.width > kMaxPoints / h.height)
     throw InputError(path + ": WIDTH * HEIGHT (" + std::to_string(h.width) + " * " + std::to_string(h.height) +
@@ -126,6 +150,18 @@ Header readHeader(std::ifstream& in, const std::string& path) {
     throw InputError(path + ": field 'POINTS' (" + std::to_string(h.points) + ") is not WIDTH * HEIGHT (" +
                      std::to_string(h.width * h.height) + ")");
   return h;
+}
+
+Header readHeader(std::ifstream& in, const std::string& path) {
+  HeaderInProgress r;
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (number > 64) throw InputError(path + ": no DATA line in the first 64 lines: not a PCD header");
+    const auto f = splitFields(line);
+    if (f.empty() || f[0].front() == '#') continue;
+    if (!readHeaderLine(f, r, in, LineRef{path, number})) break;
+  }
+  return completeHeader(r, path);
 }
 
 }  // namespace
