@@ -128,34 +128,43 @@ class Partitioner {
     d.child_depth = current.depth;
     if (members.size() < 2) return d;  // Leaf / TooFewNodes by default
     const WeightMatrix sub = inducedSubgraph(W_, members, local_of);
-
-    // A disconnected graph is split into its components first: their Ncut is
-    // 0, and the eigensolver then never meets a repeated zero eigenvalue.
-    auto components = connectedComponents(sub);
-    if (components.size() > 1) {
-      d.node.kind = SplitNode::Kind::Components;
-      d.node.outcome = SplitNode::Outcome::Accepted;
-      d.node.accepted = true;
-      d.node.ncut = 0.0;
-      for (auto& component : components) {
-        for (int& local : component) local = members[local];
-        d.children.push_back(std::move(component));
-      }
-      return d;
-    }
-
+    if (splitIntoComponents(sub, members, d)) return d;
     const int min_size = std::max(1, options_.min_group_size);
     if (static_cast<int>(members.size()) < 2 * min_size) return d;  // TooFewNodes
     if (current.depth >= options_.max_depth) {
       d.node.outcome = SplitNode::Outcome::MaxDepth;
       return d;
     }
+    Bisection b;
+    if (!bisect(sub, members, min_size, b, d)) return d;
+    judgeBisection(b, members, min_size, current.depth, d);
+    return d;
+  }
 
+  /// A disconnected graph is split into its components first: their Ncut is
+  /// 0, and the eigensolver then never meets a repeated zero eigenvalue.
+  static bool splitIntoComponents(const WeightMatrix& sub, const std::vector<int>& members, Decision& d) {
+    auto components = connectedComponents(sub);
+    if (components.size() < 2) return false;
+    d.node.kind = SplitNode::Kind::Components;
+    d.node.outcome = SplitNode::Outcome::Accepted;
+    d.node.accepted = true;
+    d.node.ncut = 0.0;
+    for (auto& component : components) {
+      for (int& local : component) local = members[local];
+      d.children.push_back(std::move(component));
+    }
+    return true;
+  }
+
+  /// The spectral bisection of a connected node (sec. II-A), recorded in the
+  /// node; false when no eigenvector could be trusted (the node stays whole).
+  bool bisect(const WeightMatrix& sub, const std::vector<int>& members, int min_size, Bisection& b,
+              Decision& d) const {
     FiedlerOptions eigen = options_.eigen;
     eigen.elimination_rank.clear();
     if (!rank_.empty())
       for (int i : members) eigen.elimination_rank.push_back(rank_[i]);
-    Bisection b;
     try {
       b = spectralBisection(sub, options_.split, eigen, min_size);
     } catch (const EigenSolverError& e) {
@@ -164,7 +173,7 @@ class Partitioner {
       d.node.outcome = SplitNode::Outcome::EigenSolverFailed;
       d.warning = std::string(e.what()) + "; a group of " + std::to_string(members.size()) +
                   " observations (first " + std::to_string(members.front()) + ") was kept whole";
-      return d;
+      return false;
     }
     d.node.attempted = true;
     d.node.solver_fell_back = b.fiedler.fell_back;
@@ -176,7 +185,13 @@ class Partitioner {
     d.node.eigenvalue = b.fiedler.eigenvalue;
     d.node.sparse_solver = b.fiedler.sparse;
     if (options_.keep_eigenvectors) d.node.eigenvector = std::move(b.fiedler.y);
+    return true;
+  }
 
+  /// Accepts the bisection while Ncut < the threshold and both sides are
+  /// large enough (sec. II-B), else says why not.
+  void judgeBisection(const Bisection& b, const std::vector<int>& members, int min_size, int depth,
+                      Decision& d) const {
     std::vector<int> a, rest;
     for (std::size_t k = 0; k < members.size(); ++k) (b.in_a[k] ? a : rest).push_back(members[k]);
     if (!b.valid) {
@@ -192,9 +207,8 @@ class Partitioner {
       // The side holding the smallest observation comes first.
       if (rest.front() < a.front()) std::swap(a, rest);
       d.children = {std::move(a), std::move(rest)};
-      d.child_depth = current.depth + 1;
+      d.child_depth = depth + 1;
     }
-    return d;
   }
 
   Partition collect(int n) {
