@@ -288,120 +288,150 @@ struct PairAlignment {
 /// target's frame): robust (Cauchy) point-to-line or point-to-plane
 /// Gauss-Newton, the correspondence gate shrinking from
 /// max_correspondence_distance to 3 x inlier_distance.
-PairAlignment alignPair(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& guess,
-                        const Freedom& freedom, const RefinementParameters& parameters) {
-  PairAlignment result;
-  flann::KNNSimpleResultSet<float> nearest(1);
-  const auto& points = source.cloud->points;
-  if (points.size() < 6 || target.cloud->size() < 6) return result;
-  const double inlier = parameters.inlier_distance;
-  const double final_gate = 3 * inlier;
-  Eigen::Isometry3d pose = guess;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  double radius = 1.0;
-  double weight_sum = 0, score = 0;
-  const auto accumulate = [&](double g, Matrix6d& H, Vector6d& gradient, double& squares, int& inliers) {
-    weight_sum = 0;
-    score = 0;
-    H.setZero();
-    gradient.setZero();
-    squares = 0;
-    inliers = 0;
+class PairAligner {
+ public:
+  PairAligner(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& guess,
+              const Freedom& freedom, const RefinementParameters& parameters)
+      : source_(source), target_(target), guess_(guess), freedom_(freedom), parameters_(parameters),
+        inlier_(parameters.inlier_distance), final_gate_(3 * parameters.inlier_distance) {}
+
+  PairAlignment align() {
+    if (source_.cloud->size() < 6 || target_.cloud->size() < 6) return {};
+    pose_ = bestStart();
+    if (!pose_.matrix().allFinite() || accumulate(final_gate_) < 6) return {};
+    const double overlap = double(inliers_) / double(source_.cloud->size());
+    const Eigen::Isometry3d correction = guess_.inverse() * pose_;
+    if (overlap < parameters_.min_overlap ||
+        correction.translation().norm() > parameters_.max_translation_correction ||
+        rotationAngle(correction) > parameters_.max_rotation_correction)
+      return {};
+    return result();
+  }
+
+ private:
+  /// The normal equations of the matches within `gate` at pose_, and the
+  /// soft inlier score (as consistency()); returns the number of matches.
+  int accumulate(double gate) {
+    weight_sum_ = score_ = squares_ = 0;
+    H_.setZero();
+    gradient_.setZero();
+    inliers_ = 0;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double squared_sum = 0;
     int used = 0;
+    const auto& points = source_.cloud->points;
     for (std::size_t i = 0; i < points.size(); ++i) {
-      const Eigen::Vector3d x = pose * points[i].getVector3fMap().cast<double>();
+      const Eigen::Vector3d x = pose_ * points[i].getVector3fMap().cast<double>();
       double r;
       Eigen::Vector3d n;
-      if (!residual(target, x, pose.linear() * source.normals[i], g, r, n, nearest)) continue;
+      if (!residual(target_, x, pose_.linear() * source_.normals[i], gate, r, n, nearest_)) continue;
       Vector6d J;
       J << n, x.cross(n);
-      const double w = 1.0 / (1.0 + (r / inlier) * (r / inlier));  // Cauchy: far matches barely pull
-      H += w * J * J.transpose();
+      const double w = 1.0 / (1.0 + (r / inlier_) * (r / inlier_));  // Cauchy: far matches barely pull
+      H_ += w * J * J.transpose();
       // What the match can tell in the moving directions: a floor tells a
       // ground robot nothing about x, y or yaw.
-      const double telling = freedom.planar ? n.head<2>().squaredNorm() : 1.0;
-      weight_sum += w * telling;
-      score += std::max(0.0, 1.0 - (r / inlier) * (r / inlier)) * telling;
-      gradient += w * J * r;
+      const double telling = freedom_.planar ? n.head<2>().squaredNorm() : 1.0;
+      weight_sum_ += w * telling;
+      score_ += std::max(0.0, 1.0 - (r / inlier_) * (r / inlier_)) * telling;
+      gradient_ += w * J * r;
       sum += x;
       squared_sum += x.squaredNorm();
       ++used;
-      if (std::abs(r) < inlier) {
-        squares += r * r;
-        ++inliers;
+      if (std::abs(r) < inlier_) {
+        squares_ += r * r;
+        ++inliers_;
       }
     }
     if (used > 0) {
-      centre = sum / used;
-      radius = std::max(0.5, std::sqrt(std::max(0.0, squared_sum / used - centre.squaredNorm())));
+      centre_ = sum / used;
+      radius_ = std::max(0.5, std::sqrt(std::max(0.0, squared_sum / used - centre_.squaredNorm())));
     }
     return used;
-  };
-  Matrix6d H;
-  Vector6d gradient;
-  double squares;
-  int inliers;
-  // Gauss-Newton from the guess with the gate shrinking from `gate`; the
-  // soft inlier score (as consistency()) of where it ends, -1 if it failed.
-  const auto descend = [&](double gate) {
-    pose = guess;
-    for (int iteration = 0; iteration < parameters.max_iterations; ++iteration) {
-      if (accumulate(gate, H, gradient, squares, inliers) < 6) return -1.0;
-      const Vector6d step = constrainedStep(H, gradient, freedom, normaliser(freedom, centre, radius),
-                                            parameters.min_constraint_ratio * weight_sum);
-      pose = exponential(step, freedom.planar) * pose;
-      const bool at_final_gate = gate <= final_gate;
-      gate = std::max(final_gate, gate * 0.7);
+  }
+
+  /// Gauss-Newton from the guess with the gate shrinking from `gate`; the
+  /// soft inlier score of where it ends (in pose_), -1 if it failed.
+  double descend(double gate) {
+    pose_ = guess_;
+    for (int iteration = 0; iteration < parameters_.max_iterations; ++iteration) {
+      if (accumulate(gate) < 6) return -1.0;
+      const Vector6d step = constrainedStep(H_, gradient_, freedom_, normaliser(freedom_, centre_, radius_),
+                                            parameters_.min_constraint_ratio * weight_sum_);
+      pose_ = exponential(step, freedom_.planar) * pose_;
+      const bool at_final_gate = gate <= final_gate_;
+      gate = std::max(final_gate_, gate * 0.7);
       if (at_final_gate && step.head<3>().norm() < 1e-5 && step.tail<3>().norm() < 1e-6) break;
     }
-    return accumulate(final_gate, H, gradient, squares, inliers) < 6 ? -1.0 : score;
-  };
-  // A wide first gate reaches larger errors but, on a small one, lets far
-  // surfaces pull the pose into another basin (seen with depth cameras:
-  // 3 cm off became 30 cm off). Both are tried (the wide one only when the
-  // narrow one had something to correct), and the guess itself: the pose
-  // that puts most points on the target's surface wins.
-  pose = guess;
-  double best_score = accumulate(final_gate, H, gradient, squares, inliers) < 6 ? -1.0 : score;
-  Eigen::Isometry3d best = guess;
-  for (const double gate : {final_gate, std::max(parameters.max_correspondence_distance, final_gate)}) {
-    const double s = descend(gate);
-    if (s > best_score) {
-      best_score = s;
-      best = pose;
-    }
-    // The narrow start stayed where the guess put it and found the target's
-    // surface there: the guess was right (exact poses), and the wide start,
-    // for errors the narrow one cannot reach, would only cost time.
-    const Eigen::Isometry3d moved = guess.inverse() * pose;
-    if (s >= 0 && inliers >= parameters.min_overlap * double(points.size()) && moved.translation().norm() < 1e-3 &&
-        rotationAngle(moved) < 1e-4)
-      break;
+    return accumulate(final_gate_) < 6 ? -1.0 : score_;
   }
-  if (best_score < 0) return result;
-  pose = best;
-  const int used = accumulate(final_gate, H, gradient, squares, inliers);
-  if (used < 6 || !pose.matrix().allFinite()) return result;
-  const double overlap = double(inliers) / double(points.size());
-  const Eigen::Isometry3d correction = guess.inverse() * pose;
-  if (overlap < parameters.min_overlap || correction.translation().norm() > parameters.max_translation_correction ||
-      rotationAngle(correction) > parameters.max_rotation_correction)
-    return result;
-  // Noise of the matches, from the inliers; a floor keeps near-perfect
-  // simulated data from claiming an absurd certainty.
-  const double sigma2 = std::max(squares / std::max(inliers, 1), 1e-6);
-  const Constrained c = constrain(activeBlock(H, freedom) / sigma2, normaliser(freedom, centre, radius),
-                                  parameters.min_constraint_ratio * weight_sum / sigma2);
-  result.usable = true;
-  result.pose = pose;
-  result.information = c.information;
-  result.partial = c.dropped > 0;
-  result.floor = parameters.min_constraint_ratio * weight_sum / sigma2;
-  result.radius = radius;
-  result.centre = centre;
-  return result;
+
+  /// A wide first gate reaches larger errors but, on a small one, lets far
+  /// surfaces pull the pose into another basin (seen with depth cameras:
+  /// 3 cm off became 30 cm off). Both are tried (the wide one only when the
+  /// narrow one had something to correct), and the guess itself: the pose
+  /// that puts most points on the target's surface wins. A NaN pose when
+  /// none matched.
+  Eigen::Isometry3d bestStart() {
+    pose_ = guess_;
+    double best_score = accumulate(final_gate_) < 6 ? -1.0 : score_;
+    Eigen::Isometry3d best = guess_;
+    for (const double gate : {final_gate_, std::max(parameters_.max_correspondence_distance, final_gate_)}) {
+      const double s = descend(gate);
+      if (s > best_score) {
+        best_score = s;
+        best = pose_;
+      }
+      // The narrow start stayed where the guess put it and found the target's
+      // surface there: the guess was right (exact poses), and the wide start,
+      // for errors the narrow one cannot reach, would only cost time.
+      const Eigen::Isometry3d moved = guess_.inverse() * pose_;
+      if (s >= 0 && inliers_ >= parameters_.min_overlap * double(source_.cloud->size()) &&
+          moved.translation().norm() < 1e-3 && rotationAngle(moved) < 1e-4)
+        break;
+    }
+    if (best_score < 0) best.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
+    return best;
+  }
+
+  /// The alignment at pose_ (accumulated at the final gate) with its
+  /// information, well-conditioned directions only.
+  PairAlignment result() const {
+    // Noise of the matches, from the inliers; a floor keeps near-perfect
+    // simulated data from claiming an absurd certainty.
+    const double sigma2 = std::max(squares_ / std::max(inliers_, 1), 1e-6);
+    const Constrained c = constrain(activeBlock(H_, freedom_) / sigma2, normaliser(freedom_, centre_, radius_),
+                                    parameters_.min_constraint_ratio * weight_sum_ / sigma2);
+    PairAlignment out;
+    out.usable = true;
+    out.pose = pose_;
+    out.information = c.information;
+    out.partial = c.dropped > 0;
+    out.floor = parameters_.min_constraint_ratio * weight_sum_ / sigma2;
+    out.radius = radius_;
+    out.centre = centre_;
+    return out;
+  }
+
+  const PreparedMember& source_;
+  const PreparedMember& target_;
+  const Eigen::Isometry3d guess_;
+  const Freedom& freedom_;
+  const RefinementParameters& parameters_;
+  const double inlier_, final_gate_;
+  flann::KNNSimpleResultSet<float> nearest_{1};
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  double radius_ = 1.0;
+  double weight_sum_ = 0, score_ = 0, squares_ = 0;
+  int inliers_ = 0;
+  Matrix6d H_;
+  Vector6d gradient_;
+};
+
+PairAlignment alignPair(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& guess,
+                        const Freedom& freedom, const RefinementParameters& parameters) {
+  return PairAligner(source, target, guess, freedom, parameters).align();
 }
 
 struct GraphEdge {
