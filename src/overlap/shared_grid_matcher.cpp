@@ -96,6 +96,128 @@ void sortByCell(std::vector<Entry>& entries, int threads) {
   }
 }
 
+/// The cell of a point: cells a hair larger than delta, so that two points
+/// within delta differ by at most one in every cell index, whatever the
+/// rounding of x / cell.
+class CellIndexer {
+ public:
+  explicit CellIndexer(double delta) : inv_cell_(1.0 / (delta * (1.0 + 1e-6))) {}
+  CellKey operator()(const Eigen::Vector3f& p) const {
+    return {index(p.x()), index(p.y()), index(p.z())};
+  }
+
+ private:
+  std::int32_t index(float v) const {
+    const double c = std::floor(double(v) * inv_cell_);
+    if (!(std::abs(c) < double(1 << 30)))
+      throw std::invalid_argument("shared grid: a point lies too far from the map centre for the grid "
+                                  "(coordinate " + std::to_string(v) + " m); use a larger delta or the "
+                                  "PCL search back-end");
+    return static_cast<std::int32_t>(c);
+  }
+  double inv_cell_;
+};
+
+/// Every world point in (cell, observation) order, with its cell and its
+/// observation. A point too far out for the grid is an InvalidObservation
+/// naming the lowest such observation, whatever the thread count.
+struct SortedPoints {
+  std::vector<Entry> entries;  ///< cell and world index of each sorted point
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::int32_t> observation;
+};
+
+SortedPoints sortPointsByCell(const WorldPoints& world, const CellIndexer& cell_of, int threads) {
+  const std::size_t total = world.points.size();
+  if (total >= std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("shared grid: more than 4 billion points");
+  SortedPoints sorted;
+  sorted.entries.resize(total);
+  const int n = world.size();
+  parallelFor(n, threads, 64, [&](std::size_t i) {
+    try {
+      for (std::size_t k = world.offsets[i]; k < world.offsets[i + 1]; ++k)
+        sorted.entries[k] = Entry{cell_of(world.points[k]), static_cast<std::uint32_t>(k)};
+    } catch (const std::invalid_argument& e) {
+      throw InvalidObservation(static_cast<int>(i), e.what());
+    }
+  });
+  sortByCell(sorted.entries, threads);
+  // The gathers are random reads, done in parallel.
+  std::vector<std::int32_t> observation_of(total);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i)
+    std::fill(observation_of.begin() + world.offsets[i], observation_of.begin() + world.offsets[i + 1], i);
+  sorted.points.resize(total);
+  sorted.observation.resize(total);
+#pragma omp parallel for num_threads(threads) schedule(static, 65536)
+  for (std::size_t k = 0; k < total; ++k) {
+    sorted.points[k] = world.points[sorted.entries[k].index];
+    sorted.observation[k] = observation_of[sorted.entries[k].index];
+  }
+  return sorted;
+}
+
+/// The sorted points cut into cells and runs (one observation's points in
+/// one cell), and the key of each cell.
+struct CellRuns {
+  std::vector<CellKey> keys;
+  std::vector<Span> cell_runs;  ///< each cell's runs
+  std::vector<Run> runs;
+};
+
+/// Each thread takes a slice of the points and first counts the cells and
+/// runs that start in it, so the layout is the same for any thread count.
+CellRuns cutRuns(const std::vector<Entry>& entries, const std::vector<std::int32_t>& observation, int threads) {
+  const std::size_t total = entries.size();
+  const auto new_cell = [&](std::size_t k) { return k == 0 || !(entries[k].key == entries[k - 1].key); };
+  const auto new_run = [&](std::size_t k) { return new_cell(k) || observation[k] != observation[k - 1]; };
+  const int slices = threads;
+  std::vector<std::size_t> cells_before(slices + 1, 0), runs_before(slices + 1, 0);
+  const auto bound = [&](int t) { return total * std::size_t(t) / std::size_t(slices); };
+#pragma omp parallel for num_threads(slices) schedule(static, 1)
+  for (int t = 0; t < slices; ++t) {
+    std::size_t cells = 0, runs = 0;  // local: the slices' counters share a cache line
+    for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
+      cells += new_cell(k);
+      runs += new_run(k);
+    }
+    cells_before[t + 1] = cells;
+    runs_before[t + 1] = runs;
+  }
+  for (int t = 0; t < slices; ++t) {
+    cells_before[t + 1] += cells_before[t];
+    runs_before[t + 1] += runs_before[t];
+  }
+  const std::size_t cells = cells_before[slices], runs = runs_before[slices];
+  CellRuns out;
+  out.keys.resize(cells);
+  out.cell_runs.resize(cells);
+  out.runs.resize(runs);
+#pragma omp parallel num_threads(slices)
+  {
+#pragma omp for schedule(static, 1)
+    for (int t = 0; t < slices; ++t) {
+      std::size_t c = cells_before[t], r = runs_before[t];
+      for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
+        if (new_cell(k)) {
+          out.keys[c] = entries[k].key;
+          out.cell_runs[c++].begin = static_cast<std::uint32_t>(r);
+        }
+        if (new_run(k)) out.runs[r++] = Run{observation[k], static_cast<std::uint32_t>(k), 0};
+      }
+    }
+    // Each run ends where the next begins, each cell's runs where the next cell's do.
+#pragma omp for schedule(static)
+    for (std::size_t r = 0; r < runs; ++r)
+      out.runs[r].end = r + 1 < runs ? out.runs[r + 1].begin : static_cast<std::uint32_t>(total);
+#pragma omp for schedule(static)
+    for (std::size_t c = 0; c < cells; ++c)
+      out.cell_runs[c].end = c + 1 < cells ? out.cell_runs[c + 1].begin : static_cast<std::uint32_t>(runs);
+  }
+  return out;
+}
+
 /// Every world point sorted by (cell, observation), cut into runs, plus for
 /// each cell the runs of its neighbourhood. Cells sorted by key make the
 /// neighbourhood a few contiguous slices of the run array: in a column of
@@ -105,10 +227,19 @@ void sortByCell(std::vector<Entry>& entries, int threads) {
 class Grid {
  public:
   Grid(const WorldPoints& world, double delta, int threads) : world_(world), threads_(threads) {
-    // Cells a hair larger than delta: two points within delta then differ by
-    // at most one in every cell index, whatever the rounding of x / cell.
-    inv_cell_ = 1.0 / (delta * (1.0 + 1e-6));
-    build();
+    SortedPoints sorted = sortPointsByCell(world, CellIndexer(delta), threads);
+    const auto& entries = sorted.entries;
+    flat_ = std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.key.z == entries[0].key.z; });
+    columns_ = flat_ ? 3 : 9;
+    CellRuns cut = cutRuns(sorted.entries, sorted.observation, threads);
+    points_ = std::move(sorted.points);
+    sorted = {};  // the entries and observations are in the runs now
+    runs_ = std::move(cut.runs);
+    cell_runs_ = std::move(cut.cell_runs);
+    planar_ = std::all_of(points_.begin(), points_.end(), [&](const Eigen::Vector3f& p) { return p.z() == points_[0].z(); });
+    indexRunsByObservation();
+    buildNeighbourhoods(cut.keys);
+    countObservationsNear();
   }
 
   std::size_t cells() const { return cell_runs_.size(); }
@@ -130,115 +261,6 @@ class Grid {
   int observations() const { return world_.size(); }
 
  private:
-  CellKey cellOf(const Eigen::Vector3f& p) const {
-    const auto index = [this](float v) {
-      const double c = std::floor(double(v) * inv_cell_);
-      if (!(std::abs(c) < double(1 << 30)))
-        throw std::invalid_argument("shared grid: a point lies too far from the map centre for the grid "
-                                    "(coordinate " + std::to_string(v) + " m); use a larger delta or the "
-                                    "PCL search back-end");
-      return static_cast<std::int32_t>(c);
-    };
-    return {index(p.x()), index(p.y()), index(p.z())};
-  }
-
-  std::vector<Entry> cellEntries() const {
-    const std::size_t total = world_.points.size();
-    if (total >= std::numeric_limits<std::uint32_t>::max())
-      throw std::invalid_argument("shared grid: more than 4 billion points");
-    std::vector<Entry> entries(total);
-    const int n = world_.size();
-    parallelFor(n, threads_, 64, [&](std::size_t i) {
-      try {
-        for (std::size_t k = world_.offsets[i]; k < world_.offsets[i + 1]; ++k)
-          entries[k] = Entry{cellOf(world_.points[k]), static_cast<std::uint32_t>(k)};
-      } catch (const std::invalid_argument& e) {
-        throw InvalidObservation(static_cast<int>(i), e.what());
-      }
-    });
-    return entries;
-  }
-
-  void build() {
-    std::vector<Entry> entries = cellEntries();
-    sortByCell(entries, threads_);
-    const std::size_t total = entries.size();
-    flat_ = std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.key.z == entries[0].key.z; });
-    columns_ = flat_ ? 3 : 9;
-    // The gathers are random reads, done in parallel.
-    std::vector<std::int32_t> observation_of(total);
-#pragma omp parallel for num_threads(threads_) schedule(dynamic, 64)
-    for (int i = 0; i < world_.size(); ++i)
-      std::fill(observation_of.begin() + world_.offsets[i], observation_of.begin() + world_.offsets[i + 1], i);
-    points_.resize(total);
-    std::vector<std::int32_t> grid_observation(total);
-#pragma omp parallel for num_threads(threads_) schedule(static, 65536)
-    for (std::size_t k = 0; k < total; ++k) {
-      points_[k] = world_.points[entries[k].index];
-      grid_observation[k] = observation_of[entries[k].index];
-    }
-    observation_of = {};
-    const std::vector<CellKey> keys = cutRuns(entries, grid_observation);
-    entries = {};
-    planar_ = std::all_of(points_.begin(), points_.end(), [&](const Eigen::Vector3f& p) { return p.z() == points_[0].z(); });
-    indexRunsByObservation();
-    buildNeighbourhoods(keys);
-    countObservationsNear();
-  }
-
-  /// Cuts the sorted points into cells and runs (one observation's points in
-  /// one cell) and returns the key of each cell. Each thread takes a slice of
-  /// the points and first counts the cells and runs that start in it, so the
-  /// layout is the same for any thread count.
-  std::vector<CellKey> cutRuns(const std::vector<Entry>& entries, const std::vector<std::int32_t>& observation) {
-    const std::size_t total = entries.size();
-    const auto new_cell = [&](std::size_t k) { return k == 0 || !(entries[k].key == entries[k - 1].key); };
-    const auto new_run = [&](std::size_t k) { return new_cell(k) || observation[k] != observation[k - 1]; };
-    const int slices = threads_;
-    std::vector<std::size_t> cells_before(slices + 1, 0), runs_before(slices + 1, 0);
-    const auto bound = [&](int t) { return total * std::size_t(t) / std::size_t(slices); };
-#pragma omp parallel for num_threads(slices) schedule(static, 1)
-    for (int t = 0; t < slices; ++t) {
-      std::size_t cells = 0, runs = 0;  // local: the slices' counters share a cache line
-      for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
-        cells += new_cell(k);
-        runs += new_run(k);
-      }
-      cells_before[t + 1] = cells;
-      runs_before[t + 1] = runs;
-    }
-    for (int t = 0; t < slices; ++t) {
-      cells_before[t + 1] += cells_before[t];
-      runs_before[t + 1] += runs_before[t];
-    }
-    const std::size_t cells = cells_before[slices], runs = runs_before[slices];
-    std::vector<CellKey> keys(cells);
-    cell_runs_.resize(cells);
-    runs_.resize(runs);
-#pragma omp parallel num_threads(slices)
-    {
-#pragma omp for schedule(static, 1)
-      for (int t = 0; t < slices; ++t) {
-        std::size_t c = cells_before[t], r = runs_before[t];
-        for (std::size_t k = bound(t); k < bound(t + 1); ++k) {
-          if (new_cell(k)) {
-            keys[c] = entries[k].key;
-            cell_runs_[c++].begin = static_cast<std::uint32_t>(r);
-          }
-          if (new_run(k)) runs_[r++] = Run{observation[k], static_cast<std::uint32_t>(k), 0};
-        }
-      }
-      // Each run ends where the next begins, each cell's runs where the next cell's do.
-#pragma omp for schedule(static)
-      for (std::size_t r = 0; r < runs; ++r)
-        runs_[r].end = r + 1 < runs ? runs_[r + 1].begin : static_cast<std::uint32_t>(total);
-#pragma omp for schedule(static)
-      for (std::size_t c = 0; c < cells; ++c)
-        cell_runs_[c].end = c + 1 < cells ? cell_runs_[c + 1].begin : static_cast<std::uint32_t>(runs);
-    }
-    return keys;
-  }
-
   /// Each observation's runs in cell order: a counting sort of the runs.
   /// Each thread counts the runs of each observation in its slice of the
   /// cells; slice t's runs of an observation go after those of slices before
@@ -321,7 +343,6 @@ class Grid {
 
   const WorldPoints& world_;
   int threads_;
-  double inv_cell_ = 0.0;
   bool flat_ = true, planar_ = true;
   int columns_ = 3;
   std::vector<Eigen::Vector3f> points_;
