@@ -34,6 +34,7 @@ const std::string kData = OBSGROUP_DATA_DIR;
 struct Result {
   int code = -1;
   std::string err;
+  std::string out;
 };
 
 std::string readFile(const fs::path& path) {
@@ -53,10 +54,10 @@ class Cli : public obsgroup::test::TempFolderTest {
  protected:
 
   Result run(const std::string& args) const {
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = std::string(OBSGROUP_EXE) + " " + args + " > /dev/null 2> " + err.string();
+    const fs::path err = dir_ / "stderr.txt", out = dir_ / "stdout.txt";
+    const std::string command = std::string(OBSGROUP_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
     const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readFile(err)};
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readFile(err), readFile(out)};
   }
 };
 
@@ -595,6 +596,50 @@ TEST_F(Cli, UsageErrors) {
   EXPECT_NE(missing.err.find("no such file or folder"), std::string::npos) << missing.err;
   EXPECT_EQ(run("--help").code, 0);
   EXPECT_EQ(run("partition --help").code, 0);
+}
+
+// What a user reads when an option or a command is wrong: the command's own
+// words, prefixed, exit 2, never CLI11's ranges and enum tables.
+TEST_F(Cli, UsageMessagesSayWhatIsWrong) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const std::string out = " -o " + (dir_ / "out").string();
+  const auto expectUsage = [&](const std::string& args, const std::string& message) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err.rfind("obsgroup: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find("1797"), std::string::npos) << r.err;
+  };
+  expectUsage("", "a command is required: partition");
+  expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition)");
+  expectUsage("partition " + input + out + " --sso points --delta 0", "--delta: must be > 0 (got 0)");
+  expectUsage("partition " + input + out + " --sso points --delta 0.2cm", "'0.2cm' is not a number");
+  expectUsage("partition " + input + out + " --sso points --delta nan", "'nan' is not a finite number");
+  expectUsage("partition " + input + out + " --map-voxel nan", "'nan' is not a finite number");
+  expectUsage("partition " + input + out + " --refine slam", "'slam' is not one of none, icp or lum");
+  expectUsage("partition " + input + out + " --threads 1.5", "'1.5' is not a whole number");
+  expectUsage("partition " + input + out + " --fov 400", "must be between 1 and 360");
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+  const Result help = run("partition --help");
+  EXPECT_EQ(help.code, 0);
+  for (const char* choices : {"none|icp|lum", "points|free-space|visibility", "mean|sign|best", "tum|kitti"})
+    EXPECT_NE(help.out.find(choices), std::string::npos) << choices;
+  for (const char* noise : {"ENUM", "{false}", "->", "1797"}) EXPECT_EQ(help.out.find(noise), std::string::npos) << noise;
+  EXPECT_NE(help.out.find("(default: visibility)"), std::string::npos);
+  EXPECT_NE(help.out.find("(default: none)"), std::string::npos);
+}
+
+// partition.json's timing says how many threads ran, and one group is "1 group".
+TEST_F(Cli, ThreadsRecordedAreThoseUsed) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const Result r = run("partition " + input + " --no-pictures --threads 1 -o " + (dir_ / "one").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readJson(dir_ / "one" / "partition.json").at("timing_s").at("threads"), 1);
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "all").string()).code, 0);
+  EXPECT_GE(readJson(dir_ / "all" / "partition.json").at("timing_s").at("threads").get<int>(), 1);
+  const Result one = run("partition " + input + " --no-pictures --ncut-threshold 0 -o " + (dir_ / "whole").string());
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_NE(one.err.find(", 1 group\n"), std::string::npos) << one.err;
 }
 
 TEST_F(Cli, SameResultsForOneAndTwoThreads) {
