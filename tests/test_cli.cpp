@@ -750,7 +750,8 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
     }
     // Nothing but the results and the test's own files beside them.
     for (const auto& entry : fs::directory_iterator(dir_))
-      EXPECT_TRUE(entry.path().filename() == "out" || entry.path().filename() == "stderr.txt") << entry.path();
+      EXPECT_TRUE(entry.path().filename() == "out" || entry.path().filename() == "stderr.txt" ||
+                  entry.path().filename() == "stdout.txt") << entry.path();
   }
   EXPECT_TRUE(saw_interrupted);
   EXPECT_TRUE(saw_completed);
