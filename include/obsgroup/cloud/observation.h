@@ -6,10 +6,20 @@
 #include "obsgroup/common/invalid_observation.h"
 
 #include <pcl/point_cloud.h>
+#include <pcl/types.h>
+
+#include <type_traits>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 namespace obsgroup {
+
+// A group (Partition::groups, a local map's members) is a list of
+// observation indices: with PCL's default 32-bit index_t it is a
+// pcl::Indices, and the PCL layer takes groups as such.
+static_assert(std::is_same_v<pcl::Indices, std::vector<int>>,
+              "obsgroup's groups are pcl::Indices: PCL must be built with its default 32-bit signed index_t");
 
 template <typename PointT>
 struct Observation {

@@ -56,7 +56,7 @@ class LocalMapBuilder {
 
   /// The local map of one group (observation indices, ascending); W chooses
   /// the reference and the pairs to align.
-  LocalMap<PointT> build(const std::vector<Observation<PointT>>& observations, const std::vector<int>& group,
+  LocalMap<PointT> build(const std::vector<Observation<PointT>>& observations, const pcl::Indices& group,
                          const WeightMatrix& W) const;
   /// The local maps of every group of a partition, in group order, built in
   /// parallel. An error in one group is rethrown naming it ("local map 3:
@@ -65,7 +65,7 @@ class LocalMapBuilder {
                                       const Partition& partition, const WeightMatrix& W) const;
 
  private:
-  LocalMap<PointT> buildGroup(const std::vector<Observation<PointT>>& observations, const std::vector<int>& group,
+  LocalMap<PointT> buildGroup(const std::vector<Observation<PointT>>& observations, const pcl::Indices& group,
                               const WeightMatrix& W, const std::vector<Eigen::Isometry3d>& poses) const;
   void refine(const std::vector<Observation<PointT>>& observations, const WeightMatrix& W,
               LocalMap<PointT>& map) const;

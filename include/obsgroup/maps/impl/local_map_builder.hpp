@@ -32,7 +32,7 @@ typename pcl::PointCloud<PointT>::Ptr movedCloud(const pcl::PointCloud<PointT>& 
 /// True when every point of every member lies in the plane z = const: 2D
 /// scans, aligned in x, y and yaw only.
 template <typename PointT>
-bool planar(const std::vector<Observation<PointT>>& observations, const std::vector<int>& group) {
+bool planar(const std::vector<Observation<PointT>>& observations, const pcl::Indices& group) {
   bool first = true;
   float z = 0.0f;
   for (int i : group)
@@ -127,13 +127,13 @@ void LocalMapBuilder<PointT>::refine(const std::vector<Observation<PointT>>& obs
 
 template <typename PointT>
 LocalMap<PointT> LocalMapBuilder<PointT>::build(const std::vector<Observation<PointT>>& observations,
-                                                const std::vector<int>& group, const WeightMatrix& W) const {
+                                                const pcl::Indices& group, const WeightMatrix& W) const {
   return buildGroup(observations, group, W, detail::posesOf(observations));
 }
 
 template <typename PointT>
 LocalMap<PointT> LocalMapBuilder<PointT>::buildGroup(const std::vector<Observation<PointT>>& observations,
-                                                     const std::vector<int>& group, const WeightMatrix& W,
+                                                     const pcl::Indices& group, const WeightMatrix& W,
                                                      const std::vector<Eigen::Isometry3d>& poses) const {
   if (group.empty()) throw std::invalid_argument("LocalMapBuilder: empty group");
   LocalMap<PointT> map;
