@@ -6,17 +6,21 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 namespace obsgroup::test {
 
 /// Samples row-major, `channels` per pixel, each in the low `bit_depth`
-/// bits. Returns false when the file cannot be written.
+/// bits. Creates the folder; returns false when the file cannot be written.
 inline bool writePng(const std::string& path, int width, int height, const std::vector<std::uint16_t>& samples,
                      int bit_depth = 16, int colour_type = PNG_COLOR_TYPE_GRAY) {
   const int channels = colour_type == PNG_COLOR_TYPE_RGB ? 3 : colour_type == PNG_COLOR_TYPE_RGB_ALPHA ? 4
                        : colour_type == PNG_COLOR_TYPE_GRAY_ALPHA ? 2 : 1;
+  std::error_code ec;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) return false;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);

@@ -85,6 +85,7 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
 
   command.add_option("--intrinsics", args.intrinsics, "depth images: pinhole fx,fy,cx,cy in pixels (default: "
                                                       "525,525,319.5,239.5)")
+      ->option_text("FX,FY,CX,CY")
       ->group("Depth images");
   command.add_option("--depth-scale", args.depth_scale,
                      "depth images: PNG units per metre (default: 5000 tum-rgbd, 1000 redwood)")
