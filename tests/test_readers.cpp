@@ -697,3 +697,23 @@ TEST(Readers, PoseFormatIsToldByTheColumnCount) {
   EXPECT_EQ(nearestStamp(poses, 5.75, 0.2), std::nullopt);
   EXPECT_EQ(nearestStamp(poses, 100, 0.2), std::nullopt);
 }
+
+// A header declaring more pixels than its data could ever inflate to is
+// refused before the image is allocated (8000 x 8000 pixels from 90 bytes).
+TEST_F(DatasetFolder, APngHeaderLargerThanItsDataIsRefusedBeforeAllocating) {
+  std::ifstream in(png("small.png", 4, 3, ramp()), std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (int k = 0; k < 2; ++k) {  // width, height: 8000, big-endian
+    bytes[16 + 4 * k] = 0;
+    bytes[17 + 4 * k] = 0;
+    bytes[18 + 4 * k] = char(8000 >> 8);
+    bytes[19 + 4 * k] = char(8000 & 0xff);
+  }
+  const unsigned long crc = crc32(0, reinterpret_cast<const Bytef*>(bytes.data() + 12), 17);
+  for (int k = 0; k < 4; ++k) bytes[29 + k] = char((crc >> (24 - 8 * k)) & 0xff);
+  const std::string message = errorOf([&] { decodeDepthPng(bytes, "big.png"); });
+  EXPECT_NE(message.find("big.png: cannot decode the PNG: 8000x8000 pixels: more than obsgroup reads or than the "
+                         "file can hold"),
+            std::string::npos)
+      << message;
+}
