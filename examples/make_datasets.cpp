@@ -7,13 +7,22 @@
 //
 //   make_datasets OUTDIR [--force]
 // The output is deterministic; a test regenerates it and compares with data/.
+//
+//   make_datasets --tum-rgbd FOLDER
+// writes the office_3d run as a TUM RGB-D folder instead (depth.txt,
+// depth/*.png at 5000 per metre, groundtruth.txt of the optical frame: z
+// forward, x right, y down) and prints the --intrinsics it needs. Not
+// shipped; a test reads it and expects the groups of office_3d/pcd.
 
 #include "floor_plan.h"
+#include "png_writer.h"
 #include "to_cloud.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -90,11 +99,53 @@ void writeOffice3D(const fs::path& folder) {
   writeRooms(plan, route, folder / "rooms.txt");
 }
 
+/// The office_3d run as TUM RGB-D: the same rays and noise (seed k), each
+/// point back at its pixel, its depth along the optical axis.
+int writeOffice3DTum(const fs::path& folder) {
+  const FloorPlan plan = office();
+  DepthCamera camera;
+  camera.range_noise = 0.005;
+  const auto route = officeRoute(40);
+  const double f = (camera.width / 2.0) / std::tan(camera.horizontal_fov / 2);
+  const double cx = (camera.width - 1) / 2.0, cy = (camera.height - 1) / 2.0;
+  fs::create_directories(folder / "depth");
+  std::ofstream list(folder / "depth.txt"), truth(folder / "groundtruth.txt");
+  list << "# depth maps of obsgroup's simulated office (examples/make_datasets.cpp)\n# timestamp filename\n";
+  truth << "# ground truth of the optical frame (z forward, x right, y down)\n# timestamp tx ty tz qx qy qz qw\n";
+  // The optical frame in the sensor's (x ahead, y left, z up).
+  Eigen::Matrix3d body_from_optical;
+  body_from_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  char buffer[200];
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    const Pose2D& p = route[k];
+    std::vector<std::uint16_t> depth(std::size_t(camera.width) * camera.height, 0);
+    for (const Eigen::Vector3d& q : plan.depthImage(p, camera, k)) {
+      const long u = std::lround(cx - f * q.y() / q.x()), v = std::lround(cy - f * q.z() / q.x());
+      if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
+      depth[std::size_t(v) * camera.width + u] = std::uint16_t(std::lround(q.x() * 5000.0));
+    }
+    std::snprintf(buffer, sizeof buffer, "depth/%.6f.png", k * 0.5);
+    if (!obsgroup::test::writePng((folder / buffer).string(), camera.width, camera.height, depth)) {
+      std::cerr << "error: cannot write " << (folder / buffer).string() << "\n";
+      return 1;
+    }
+    list << std::string(buffer).substr(6, std::string(buffer).size() - 10) << ' ' << buffer << '\n';
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * body_from_optical;
+    const Eigen::Quaterniond q(R);
+    std::snprintf(buffer, sizeof buffer, "%.6f %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", k * 0.5, p.x, p.y,
+                  camera.height_above_floor, q.x(), q.y(), q.z(), q.w());
+    truth << buffer;
+  }
+  std::printf("wrote %s; read it with --intrinsics %.9f,%.9f,%.9f,%.9f\n", folder.string().c_str(), f, f, cx, cy);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--tum-rgbd") return writeOffice3DTum(argv[2]);
   if (argc < 2 || argc > 3 || (argc == 3 && std::string(argv[2]) != "--force")) {
-    std::cerr << "usage: " << argv[0] << " OUTDIR [--force]\n";
+    std::cerr << "usage: " << argv[0] << " OUTDIR [--force] | --tum-rgbd FOLDER\n";
     return 2;
   }
   const fs::path out = argv[1];

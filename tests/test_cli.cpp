@@ -2,6 +2,7 @@
 // behaviour on bad input: a one-line error naming file, line and field, exit
 // code 2 for usage errors and 3 for input errors.
 #include "floor_plan.h"
+#include "png_writer.h"
 #include "temp_folder.h"
 
 #include <cairo.h>
@@ -14,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -1011,4 +1013,168 @@ TEST_F(Cli, APoseFormatWithoutAPosesFileIsRefused) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--pose-format applies to a --poses file"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+// ---------------------------------------------------------------------------
+// Depth image sequences, KITTI odometry and TUM poses matched by timestamp.
+
+TEST_F(Cli, SimulatedDepthImagesGroupAsTheSamePcdSequence) {
+  // The office_3d run written as TUM RGB-D: 16-bit PNGs in the optical frame.
+  const fs::path tum = dir_ / "tum";
+  const std::string command = std::string(MAKE_DATASETS_EXE) + " --tum-rgbd " + tum.string() + " > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const double f = 40.0 / std::tan(58.0 * 3.14159265358979323846 / 360.0);
+  char intrinsics[128];
+  std::snprintf(intrinsics, sizeof intrinsics, "%.9f,%.9f,39.5,29.5", f, f);
+  const Result a = run("partition " + tum.string() + " -q --no-pictures --intrinsics " + intrinsics + " -o " +
+                       (dir_ / "a").string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  const nlohmann::json p = expectPartitionSchema(dir_ / "a", 40);
+  EXPECT_EQ(p.at("parameters").at("format"), "tum-rgbd");
+  EXPECT_EQ(p.at("parameters").at("depth_scale"), 5000.0);
+  EXPECT_EQ(p.at("parameters").at("skipped_frames"), 0);
+  ASSERT_EQ(run("partition " + kData + "/office_3d/pcd -q --no-pictures -o " + (dir_ / "b").string()).code, 0);
+  const nlohmann::json q = readJson(dir_ / "b" / "partition.json");
+  EXPECT_EQ(p.at("groups"), q.at("groups"));
+  EXPECT_EQ(p.at("statistics").at("points"), q.at("statistics").at("points"));
+  // Every other pixel: a quarter of the points, the run still goes through.
+  const Result strided = run("partition " + tum.string() + " -q --no-pictures --stride 2 --intrinsics " + intrinsics +
+                             " -o " + (dir_ / "c").string());
+  ASSERT_EQ(strided.code, 0) << strided.err;
+  EXPECT_LT(readJson(dir_ / "c" / "partition.json").at("statistics").at("points").get<double>(),
+            0.3 * q.at("statistics").at("points").get<double>());
+}
+
+namespace {
+
+void writeBinFile(const fs::path& file, const std::vector<float>& values) {
+  fs::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(values.data()),
+                                              std::streamsize(values.size() * sizeof(float)));
+}
+
+/// A lidar ring of points around the sensor, 5 m away.
+std::vector<float> ring() {
+  std::vector<float> values;
+  for (int k = 0; k < 360; ++k)
+    for (float z : {-0.5f, 0.0f, 0.5f})
+      values.insert(values.end(), {5.0f * std::cos(k * 0.01745f), 5.0f * std::sin(k * 0.01745f), z, 0.5f});
+  return values;
+}
+
+}  // namespace
+
+TEST_F(Cli, KittiAndRedwoodFoldersAreDetectedAndRead) {
+  const fs::path kitti = dir_ / "kitti";
+  writeBinFile(kitti / "velodyne" / "000000.bin", ring());
+  writeBinFile(kitti / "velodyne" / "000001.bin", ring());
+  writeFile(kitti / "calib.txt", "Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n");
+  writeFile(kitti / "poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1 1\n");
+  Result r = run("partition " + kitti.string() + " -q --no-pictures -o " + (dir_ / "k").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json p = expectPartitionSchema(dir_ / "k", 2);
+  EXPECT_EQ(p.at("parameters").at("format"), "kitti");
+  EXPECT_EQ(p.at("parameters").at("point_type"), "PointXYZI");
+  // poses.txt given with --poses: the folder is still KITTI.
+  fs::rename(kitti / "poses.txt", dir_ / "00.txt");
+  r = run("partition " + kitti.string() + " -q --no-pictures --poses " + (dir_ / "00.txt").string() + " -o " +
+          (dir_ / "k2").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ofstream(kitti / "velodyne" / "000001.bin", std::ios::binary | std::ios::app) << "xyz";
+  r = run("partition " + kitti.string() + " -q --format kitti --poses " + (dir_ / "00.txt").string() + " -o " +
+          (dir_ / "k3").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("000001.bin: 17283 bytes, not a multiple of 16"), std::string::npos) << r.err;
+
+  const fs::path redwood = dir_ / "redwood";
+  std::vector<std::uint16_t> wall(64 * 48, 3000);  // a wall 3 m ahead
+  ASSERT_TRUE(obsgroup::test::writePng((redwood / "depth" / "000000.png").string(), 64, 48, wall));
+  ASSERT_TRUE(obsgroup::test::writePng((redwood / "depth" / "000001.png").string(), 64, 48, wall));
+  writeFile(redwood / "trajectory.log", "0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+                                        "1 1 2\n1 0 0 0.1\n0 1 0 0\n0 0 1 0\n0 0 0 1\n");
+  r = run("partition " + redwood.string() + " -q --no-pictures --intrinsics 50,50,31.5,23.5 --depth-max 4 -o " +
+          (dir_ / "r").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  p = expectPartitionSchema(dir_ / "r", 2);
+  EXPECT_EQ(p.at("parameters").at("format"), "redwood");
+  EXPECT_EQ(p.at("parameters").at("depth_scale"), 1000.0);
+  EXPECT_EQ(p.at("statistics").at("points"), 2 * 64 * 48);
+  // Deeper than --depth-max: no point at all, each image a group of its own, with a warning.
+  r = run("partition " + redwood.string() + " -q --no-pictures --depth-max 2 -o " + (dir_ / "r2").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readJson(dir_ / "r2" / "partition.json").at("groups").size(), 2u);
+  writeFile(redwood / "trajectory.log", "0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n");
+  r = run("partition " + redwood.string() + " -q -o " + (dir_ / "r3").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("trajectory.log: 1 trajectory entries for 2 depth images"), std::string::npos) << r.err;
+  ASSERT_TRUE(obsgroup::test::writePng((redwood / "depth" / "000001.png").string(), 2, 2, {1, 2, 3, 4}, 8));
+  r = run("partition " + redwood.string() + " -q --format redwood --poses " + (dir_ / "00.txt").string() + " -o " +
+          (dir_ / "r4").string());
+  EXPECT_EQ(r.code, 3);  // a KITTI file is not a trajectory.log
+  EXPECT_NE(r.err.find("00.txt:1: frame 0: a block starts with a line of 3 numbers"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, DepthOptionsAreCheckedAndOnlyWhereTheyApply) {
+  const std::string log = kData + "/office_2d/office.clf";
+  const std::string out = " -o " + (dir_ / "out").string();
+  Result r = run("partition " + log + out + " --stride 2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("apply to depth images only"), std::string::npos) << r.err;
+  EXPECT_EQ(run("partition " + kData + "/office_3d/pcd" + out + " --depth-scale 1000").code, 2);
+  EXPECT_EQ(run("partition " + log + out + " --max-time-difference 0.1").code, 2);
+  const fs::path tum = dir_ / "tum";
+  ASSERT_TRUE(obsgroup::test::writePng((tum / "depth" / "1.png").string(), 4, 3, std::vector<std::uint16_t>(12, 5000)));
+  writeFile(tum / "depth.txt", "1.0 depth/1.png\n");
+  writeFile(tum / "groundtruth.txt", "1.01 0 0 0 0 0 0 1\n");
+  r = run("partition " + tum.string() + out + " --intrinsics 525,525,319.5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--intrinsics: 3 values, expected 4"), std::string::npos) << r.err;
+  EXPECT_EQ(run("partition " + tum.string() + out + " --intrinsics 0,525,1,1").code, 2);
+  EXPECT_EQ(run("partition " + tum.string() + out + " --stride 0").code, 2);
+  EXPECT_EQ(run("partition " + tum.string() + out + " --depth-scale -5").code, 2);
+  EXPECT_EQ(run("partition " + log + out + " --format tum-rgbd").code, 2);  // a file, not a folder
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+  r = run("partition " + tum.string() + " -q --no-pictures" + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readJson(dir_ / "out" / "partition.json").at("parameters").at("format"), "tum-rgbd");
+  r = run("partition " + tum.string() + " --max-time-difference 0.001 --force" + out);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("groundtruth.txt: no pose within"), std::string::npos) << r.err;
+  writeFile(tum / "depth.txt", "1.0 depth/1.png\n1.5 depth/2.png\n");
+  r = run("partition " + tum.string() + " --force" + out);
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("depth.txt:2: field 'filename': "), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, PcdFilesNamedByTimestampAreMatchedToTumPosesByTime) {
+  const fs::path seq = dir_ / "seq";
+  fs::create_directories(seq);
+  const std::vector<std::string> stamps = {"1305031102.175304", "1305031102.675304", "1305031103.175304"};
+  for (int k = 0; k < 3; ++k)
+    fs::copy_file(kData + "/office_3d/pcd/00000" + std::to_string(k) + ".pcd", seq / (stamps[k] + ".pcd"));
+  // Out of order, off by a few milliseconds, one pose too many and one cloud without a pose.
+  writeFile(dir_ / "poses.txt", "1305031103.9 9 9 9 0 0 0 1\n"
+                                "1305031102.68 3.5 1.25 1 0 0 0 1\n"
+                                "1305031102.17 1 1.25 1 0 0 0 1\n");
+  Result r = run("partition " + seq.string() + " --no-pictures --poses " + (dir_ / "poses.txt").string() + " -o " +
+                 (dir_ / "a").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 of 3 PCD files have no pose"), std::string::npos) << r.err;
+  nlohmann::json p = readJson(dir_ / "a" / "partition.json");
+  EXPECT_EQ(p.at("observations"), 2);
+  EXPECT_EQ(p.at("parameters").at("poses_matched_by"), "timestamp");
+  EXPECT_EQ(p.at("parameters").at("pose_format"), "tum");  // told by the 8 columns
+  r = run("partition " + seq.string() + " -q --no-pictures --max-time-difference 1 --poses " +
+          (dir_ / "poses.txt").string() + " -o " + (dir_ / "b").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(readJson(dir_ / "b" / "partition.json").at("observations"), 3);
+  // Files named by index: line order, where a tolerance means nothing.
+  r = run("partition " + kData + "/office_3d/pcd -q --max-time-difference 1 --poses " + kData +
+          "/office_3d/poses.txt -o " + (dir_ / "c").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("not named by timestamps"), std::string::npos) << r.err;
+  writeFile(dir_ / "odd.txt", "1 2 3 4 5\n");
+  r = run("partition " + seq.string() + " -q --poses " + (dir_ / "odd.txt").string() + " -o " + (dir_ / "d").string());
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("odd.txt:1: a pose line has 5 values: neither TUM"), std::string::npos) << r.err;
 }

@@ -1,9 +1,12 @@
 // The readers on their own: in-memory parsing, and the inputs that fuzzing
 // found mishandled, each pinned with its expected outcome.
 #include "carmen_reader.h"
+#include "depth_sequence.h"
 #include "errors.h"
+#include "kitti_sequence.h"
 #include "pcd_sequence.h"
 #include "pose_file.h"
+#include "png_writer.h"
 #include "temp_folder.h"
 
 #include <pcl/point_types.h>
@@ -18,6 +21,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <map>
 
 using namespace obsgroup::io;
@@ -437,4 +442,278 @@ TEST(Readers, VerticesApplyAcrossTheSlicesOfALargeLog) {
       EXPECT_TRUE(other.scans[k].laser_pose.isApprox(logs[0].scans[k].laser_pose, 0.0)) << k;
     EXPECT_EQ(other.warnings, logs[0].warnings);
   }
+}
+
+// ---------------------------------------------------------------------------
+// Depth image sequences (TUM RGB-D, Redwood) and KITTI odometry.
+
+namespace {
+
+/// A fresh folder for a synthetic dataset.
+class DatasetFolder : public obsgroup::test::TempFolderTest {
+ protected:
+  void text(const std::string& name, const std::string& content) const {
+    fs::create_directories((dir_ / name).parent_path());
+    std::ofstream(dir_ / name, std::ios::binary) << content;
+  }
+  std::string png(const std::string& name, int width, int height, const std::vector<std::uint16_t>& values,
+                  int bit_depth = 16, int colour = PNG_COLOR_TYPE_GRAY) const {
+    fs::create_directories((dir_ / name).parent_path());
+    EXPECT_TRUE(obsgroup::test::writePng((dir_ / name).string(), width, height, values, bit_depth, colour));
+    return (dir_ / name).string();
+  }
+  std::string errorOf(const std::function<void()>& call) const {
+    try {
+      call();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  }
+};
+
+/// A 4x3 image: depth 1000 + 100 v + 10 u units, pixel (1, 1) no return.
+std::vector<std::uint16_t> ramp() {
+  std::vector<std::uint16_t> values;
+  for (int v = 0; v < 3; ++v)
+    for (int u = 0; u < 4; ++u) values.push_back(u == 1 && v == 1 ? 0 : std::uint16_t(1000 + 100 * v + 10 * u));
+  return values;
+}
+
+std::string tumLine(double t, const Eigen::Vector3d& p, const Eigen::Quaterniond& q) {
+  std::ostringstream s;
+  s.precision(17);
+  s << t << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' '
+    << q.w() << '\n';
+  return s.str();
+}
+
+}  // namespace
+
+TEST_F(DatasetFolder, DepthPngBackProjectsThroughThePinholeModel) {
+  const std::string file = png("depth/0.png", 4, 3, ramp());
+  const DepthImage image = readDepthPng(file);
+  ASSERT_EQ(image.width, 4);
+  ASSERT_EQ(image.height, 3);
+  EXPECT_EQ(image.values, ramp());
+  const PinholeIntrinsics k{2.0, 3.0, 1.5, 1.0};
+  const auto cloud = backProject(image, k, 1000.0, std::nullopt, 1);
+  ASSERT_EQ(cloud->size(), 11u);  // 12 pixels, one no return
+  std::size_t n = 0;
+  for (int v = 0; v < 3; ++v)
+    for (int u = 0; u < 4; ++u) {
+      if (u == 1 && v == 1) continue;
+      const double d = (1000 + 100 * v + 10 * u) / 1000.0;
+      const pcl::PointXYZ& p = (*cloud)[n++];
+      EXPECT_FLOAT_EQ(p.x, float((u - 1.5) * d / 2.0)) << u << "," << v;
+      EXPECT_FLOAT_EQ(p.y, float((v - 1.0) * d / 3.0)) << u << "," << v;
+      EXPECT_FLOAT_EQ(p.z, float(d)) << u << "," << v;
+    }
+  // Deeper than --depth-max: no return. Stride 2: pixels (0,0) (2,0) (0,2) (2,2).
+  EXPECT_EQ(backProject(image, k, 1000.0, 1.15, 1)->size(), 7u);  // rows 0 and 1
+  const auto strided = backProject(image, k, 1000.0, std::nullopt, 2);
+  ASSERT_EQ(strided->size(), 4u);
+  EXPECT_FLOAT_EQ((*strided)[3].z, 1.22f);
+}
+
+TEST_F(DatasetFolder, DepthPngOfAnotherKindIsRefusedNamingIt) {
+  const std::string grey8 = png("a.png", 2, 2, {1, 2, 3, 4}, 8);
+  std::string message = errorOf([&] { readDepthPng(grey8); });
+  EXPECT_NE(message.find("a.png: field 'IHDR': a 8-bit grey PNG; a depth image is 16-bit grey"), std::string::npos)
+      << message;
+  const std::string rgb16 = png("b.png", 1, 1, {1, 2, 3}, 16, PNG_COLOR_TYPE_RGB);
+  message = errorOf([&] { readDepthPng(rgb16); });
+  EXPECT_NE(message.find("b.png: field 'IHDR': a 16-bit RGB PNG"), std::string::npos) << message;
+  text("c.png", "not a png at all");
+  message = errorOf([&] { readDepthPng((dir_ / "c.png").string()); });
+  EXPECT_NE(message.find("c.png: not a PNG file"), std::string::npos) << message;
+  // Cut short anywhere: an error, never a crash.
+  std::ifstream in(png("d.png", 4, 3, ramp()), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (std::size_t size = 8; size + 12 < bytes.size(); ++size) {
+    message = errorOf([&] { decodeDepthPng(std::string_view(bytes).substr(0, size), "cut.png"); });
+    EXPECT_EQ(message.rfind("cut.png: ", 0), 0u) << size << ": " << message;
+  }
+}
+
+TEST_F(DatasetFolder, TumLayoutMatchesPosesByNearestTimestamp) {
+  png("depth/1.000000.png", 4, 3, ramp());
+  png("depth/1.500000.png", 4, 3, ramp());
+  png("depth/2.000000.png", 4, 3, ramp());
+  text("depth.txt", "# depth maps\n1.000000 depth/1.000000.png\n1.500000 depth/1.500000.png\n"
+                    "2.000000 depth/2.000000.png\n");
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()));
+  text("groundtruth.txt", "# timestamp tx ty tz qx qy qz qw\n" + tumLine(2.004, {3, 0, 0}, q) +
+                              tumLine(0.99, {1, 0, 0}, q) + tumLine(0.995, {1.5, 0, 0}, q) +
+                              tumLine(1.55, {2, 0, 0}, q));
+  ASSERT_EQ(detectDepthLayout(dir_.string()), DepthLayout::TumRgbd);
+  DepthOptions options;
+  DepthSequence sequence = loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, options);
+  EXPECT_EQ(sequence.depth_scale, 5000.0);
+  ASSERT_EQ(sequence.observations.size(), 2u);  // 1.5 is 0.05 s from its nearest pose
+  EXPECT_EQ(sequence.skipped, 1u);
+  EXPECT_DOUBLE_EQ(sequence.observations[0].pose.translation().x(), 1.5);  // 0.995 is nearer 1.0 than 0.99
+  EXPECT_DOUBLE_EQ(sequence.observations[1].pose.translation().x(), 3.0);
+  EXPECT_TRUE(sequence.observations[1].pose.linear().isApprox(q.toRotationMatrix(), 1e-12));
+  EXPECT_NE(sequence.labels[1].find("2.000000.png"), std::string::npos);
+  EXPECT_FLOAT_EQ((*sequence.observations[0].cloud)[0].z, 0.2f);  // 1000 / 5000
+  ASSERT_EQ(sequence.warnings.size(), 1u);
+  EXPECT_NE(sequence.warnings[0].find("1 of 3 depth frames have no pose"), std::string::npos) << sequence.warnings[0];
+  options.max_time_difference = 0.1;
+  EXPECT_EQ(loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, options).observations.size(), 3u);
+  options.max_time_difference = 0.001;
+  const std::string message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, options); });
+  EXPECT_NE(message.find("no pose within"), std::string::npos) << message;
+}
+
+TEST_F(DatasetFolder, TumLayoutErrorsNameTheFileAndLine) {
+  png("depth/1.png", 4, 3, ramp());
+  text("groundtruth.txt", tumLine(1, {0, 0, 0}, Eigen::Quaterniond::Identity()));
+  text("depth.txt", "1.0 depth/1.png\n2.0 depth/missing.png\n");
+  std::string message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, {}); });
+  EXPECT_NE(message.find("depth.txt:2: field 'filename': "), std::string::npos) << message;
+  EXPECT_NE(message.find("missing.png: no such file"), std::string::npos) << message;
+  text("depth.txt", "1.0 depth/1.png\nabc depth/1.png\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, {}); });
+  EXPECT_NE(message.find("depth.txt:2: field 'timestamp': 'abc' is not a number"), std::string::npos) << message;
+  png("depth/2.png", 2, 2, {1, 2, 3, 4}, 8);
+  text("depth.txt", "1.0 depth/2.png\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::TumRgbd, {}); });
+  EXPECT_NE(message.find("2.png: field 'IHDR': a 8-bit grey PNG"), std::string::npos) << message;
+}
+
+namespace {
+
+std::string redwoodBlock(int i, const Eigen::Matrix4d& m) {
+  std::ostringstream s;
+  s.precision(17);
+  s << i << ' ' << i << ' ' << i + 1 << '\n';
+  for (int r = 0; r < 4; ++r) s << m(r, 0) << ' ' << m(r, 1) << ' ' << m(r, 2) << ' ' << m(r, 3) << '\n';
+  return s.str();
+}
+
+}  // namespace
+
+TEST_F(DatasetFolder, RedwoodLayoutPosesEachImageInNameOrder) {
+  png("depth/2.png", 4, 3, ramp());
+  png("depth/10.png", 4, 3, std::vector<std::uint16_t>(12, 2000));
+  Eigen::Matrix4d a = Eigen::Matrix4d::Identity(), b = Eigen::Matrix4d::Identity();
+  a.topRightCorner<3, 1>() << 1, 2, 3;
+  b.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  b.topRightCorner<3, 1>() << -1, 0, 0.5;
+  text("trajectory.log", redwoodBlock(0, a) + redwoodBlock(1, b));
+  ASSERT_EQ(detectDepthLayout(dir_.string()), DepthLayout::Redwood);
+  const DepthSequence sequence = loadDepthSequence(dir_.string(), DepthLayout::Redwood, {});
+  EXPECT_EQ(sequence.depth_scale, 1000.0);
+  ASSERT_EQ(sequence.observations.size(), 2u);
+  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(a, 1e-12));
+  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(b, 1e-12));
+  EXPECT_NE(sequence.labels[1].find("10.png"), std::string::npos);  // 2 before 10
+  EXPECT_EQ(sequence.observations[1].cloud->size(), 12u);
+  EXPECT_FLOAT_EQ((*sequence.observations[1].cloud)[0].z, 2.0f);
+
+  text("trajectory.log", redwoodBlock(0, a));
+  std::string message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
+  EXPECT_NE(message.find("trajectory.log: 1 trajectory entries for 2 depth images"), std::string::npos) << message;
+  text("trajectory.log", redwoodBlock(0, a) + "1 1 2\n1 0 0 0\n0 1 0 0\n0 0 1 0\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
+  EXPECT_NE(message.find("trajectory.log:6: frame 1: the block has 3 matrix rows, expected 4"), std::string::npos)
+      << message;
+  text("trajectory.log", redwoodBlock(0, a) + "1 1 2\n1 0 0 0\n0 1 0 0\n0 0 1 x\n0 0 0 1\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
+  EXPECT_NE(message.find("trajectory.log:9: field 'm34': 'x' is not a number"), std::string::npos) << message;
+  text("trajectory.log", redwoodBlock(0, a) + "1 1 2\n2 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
+  EXPECT_NE(message.find("trajectory.log:7: frame 1: the 3x3 part is not a rotation"), std::string::npos) << message;
+  text("trajectory.log", redwoodBlock(0, a) + "1 0 0 0\n");
+  message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
+  EXPECT_NE(message.find("trajectory.log:6: frame 1: a block starts with a line of 3 numbers"), std::string::npos)
+      << message;
+}
+
+namespace {
+
+void writeBin(const fs::path& file, const std::vector<float>& values) {
+  fs::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(values.data()),
+                                              std::streamsize(values.size() * sizeof(float)));
+}
+
+}  // namespace
+
+TEST_F(DatasetFolder, KittiLidarPosesAreCameraPosesTimesTr) {
+  writeBin(dir_ / "velodyne" / "000000.bin", {1, 2, 3, 0.5f, 4, 5, 6, 0.25f});
+  writeBin(dir_ / "velodyne" / "000001.bin", {7, 8, 9, 1});
+  // The usual Tr: velodyne x forward, y left, z up to camera z forward, x right, y down; plus an offset.
+  text("calib.txt", "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: 0 -1 0 -0.01 0 0 -1 -0.08 1 0 0 -0.27\n");
+  text("poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n0 0 1 2 0 1 0 0 -1 0 0 5\n");
+  ASSERT_TRUE(isKittiFolder(dir_.string()));
+  const KittiSequence sequence = loadKittiSequence(dir_.string(), std::nullopt);
+  ASSERT_EQ(sequence.observations.size(), 2u);
+  Eigen::Matrix4d tr;
+  tr << 0, -1, 0, -0.01, 0, 0, -1, -0.08, 1, 0, 0, -0.27, 0, 0, 0, 1;
+  Eigen::Matrix4d cam1;
+  cam1 << 0, 0, 1, 2, 0, 1, 0, 0, -1, 0, 0, 5, 0, 0, 0, 1;
+  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(tr, 1e-12));
+  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(cam1 * tr, 1e-12));
+  ASSERT_EQ(sequence.observations[0].cloud->size(), 2u);
+  const pcl::PointXYZI& p = (*sequence.observations[0].cloud)[1];
+  EXPECT_EQ(p.x, 4.0f);
+  EXPECT_EQ(p.y, 5.0f);
+  EXPECT_EQ(p.z, 6.0f);
+  EXPECT_EQ(p.intensity, 0.25f);
+
+  std::ofstream(dir_ / "velodyne" / "000001.bin", std::ios::binary | std::ios::app) << "abc";
+  std::string message = errorOf([&] { loadKittiSequence(dir_.string(), std::nullopt); });
+  EXPECT_NE(message.find("000001.bin: 19 bytes, not a multiple of 16"), std::string::npos) << message;
+  writeBin(dir_ / "velodyne" / "000001.bin", {7, 8, 9, 1});
+  text("calib.txt", "Tr: 1 0 0\n");
+  message = errorOf([&] { loadKittiSequence(dir_.string(), std::nullopt); });
+  EXPECT_NE(message.find("calib.txt:1: field 'Tr': 3 values, expected 12"), std::string::npos) << message;
+  fs::remove(dir_ / "calib.txt");
+  message = errorOf([&] { loadKittiSequence(dir_.string(), std::nullopt); });
+  EXPECT_NE(message.find("calib.txt: no such file"), std::string::npos) << message;
+  text("calib.txt", "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  text("poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n");
+  message = errorOf([&] { loadKittiSequence(dir_.string(), std::nullopt); });
+  EXPECT_NE(message.find("poses.txt: 1 poses for 2 velodyne scans"), std::string::npos) << message;
+}
+
+TEST(Readers, PoseFormatIsToldByTheColumnCount) {
+  EXPECT_EQ(detectPoseFormat("# c\n\n1 0 0 0 0 0 0 1\n", "a.txt"), PoseFormat::Tum);
+  EXPECT_EQ(detectPoseFormat("1 0 0 0 0 1 0 0 0 0 1 0\n", "a.txt"), PoseFormat::Kitti);
+  try {
+    detectPoseFormat("# c\n1 2 3\n", "a.txt");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a.txt:2: a pose line has 3 values"), std::string::npos) << e.what();
+  }
+  const auto poses = parseStampedPoses("5.5 1 2 3 0 0 0 1\n6 0 0 0 0 0 0 1\n", "a.txt");
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_DOUBLE_EQ(poses[0].stamp, 5.5);
+  EXPECT_DOUBLE_EQ(poses[0].pose.translation().z(), 3.0);
+  EXPECT_EQ(nearestStamp(poses, 5.6, 0.2), std::optional<std::size_t>(0));
+  EXPECT_EQ(nearestStamp(poses, 5.9, 0.2), std::optional<std::size_t>(1));
+  EXPECT_EQ(nearestStamp(poses, 5.75, 0.2), std::nullopt);
+  EXPECT_EQ(nearestStamp(poses, 100, 0.2), std::nullopt);
+}
+
+// A header declaring more pixels than its data could ever inflate to is
+// refused before the image is allocated (8000 x 8000 pixels from 90 bytes).
+TEST_F(DatasetFolder, APngHeaderLargerThanItsDataIsRefusedBeforeAllocating) {
+  std::ifstream in(png("small.png", 4, 3, ramp()), std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (int k = 0; k < 2; ++k) {  // width, height: 8000, big-endian
+    bytes[16 + 4 * k] = 0;
+    bytes[17 + 4 * k] = 0;
+    bytes[18 + 4 * k] = char(8000 >> 8);
+    bytes[19 + 4 * k] = char(8000 & 0xff);
+  }
+  const unsigned long crc = crc32(0, reinterpret_cast<const Bytef*>(bytes.data() + 12), 17);
+  for (int k = 0; k < 4; ++k) bytes[29 + k] = char((crc >> (24 - 8 * k)) & 0xff);
+  const std::string message = errorOf([&] { decodeDepthPng(bytes, "big.png"); });
+  EXPECT_NE(message.find("big.png: cannot decode the PNG: 8000x8000 pixels: more than obsgroup reads or than the "
+                         "file can hold"),
+            std::string::npos)
+      << message;
 }

@@ -43,12 +43,13 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   using cli::oneOf;
   using cli::wholeNumber;
   command.add_option("input", args.input,
-                     "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input) or folder of .pcd files")
+                     "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input), folder of .pcd files, "
+                     "depth images (TUM RGB-D, Redwood) or KITTI odometry")
       ->required();
   command.add_option("-o,--output", args.output, "folder to write the results to")->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
-      ->check(CLI::IsMember({"auto", "carmen", "pcd"}))
-      ->option_text("auto|carmen|pcd");
+      ->check(CLI::IsMember({"auto", "carmen", "pcd", "tum-rgbd", "redwood", "kitti"}))
+      ->option_text("auto|carmen|pcd|tum-rgbd|redwood|kitti");
 
   command.add_option("--laser", args.laser, "CARMEN: which laser messages: FLASER, RLASER or ROBOTLASER1 (default: auto, "
                                             "ROBOTLASER1 if any, else FLASER, else RLASER)")
@@ -68,12 +69,34 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
                    "CARMEN: skip malformed lines (a truncated last line, say), counted in one warning")
       ->group("CARMEN logs");
 
-  command.add_option("--poses", args.poses, "PCD: poses file, one line per cloud (default: each PCD's VIEWPOINT)")
+  command.add_option("--poses", args.poses,
+                     "PCD: poses file, one line per cloud, or matched by timestamp when the files are named by one "
+                     "(default: each PCD's VIEWPOINT); depth images, KITTI: instead of the folder's")
       ->group("PCD sequences");
-  command.add_option("--pose-format", args.pose_format, "PCD: format of --poses (default: tum)")
+  command.add_option("--pose-format", args.pose_format, "PCD: format of --poses (default: from the column count, 8 "
+                                                        "tum, 12 kitti)")
       ->transform(oneOf(io::kPoseFormatNames))
       ->option_text(choices(io::kPoseFormatNames))
       ->group("PCD sequences");
+  command.add_option("--max-time-difference", args.max_time_difference,
+                     "TUM poses matched by timestamp: most seconds between a frame and its pose (default: 0.02)")
+      ->check(finiteNumber(0.0))
+      ->group("PCD sequences");
+
+  command.add_option("--intrinsics", args.intrinsics, "depth images: pinhole fx,fy,cx,cy in pixels (default: "
+                                                      "525,525,319.5,239.5)")
+      ->option_text("FX,FY,CX,CY")
+      ->group("Depth images");
+  command.add_option("--depth-scale", args.depth_scale,
+                     "depth images: PNG units per metre (default: 5000 tum-rgbd, 1000 redwood)")
+      ->check(finiteNumber(0.0, true))
+      ->group("Depth images");
+  command.add_option("--depth-max", args.depth_max, "depth images: deeper pixels are no return, metres (default: none)")
+      ->check(finiteNumber(0.0, true))
+      ->group("Depth images");
+  command.add_option("--stride", args.stride, "depth images: every Nth pixel in each direction (default: 1)")
+      ->check(wholeNumber(1))
+      ->group("Depth images");
 
   command.add_option("--sso", args.sso,
                      "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "

@@ -1,13 +1,16 @@
 #include "partition_command.h"
 
+#include "depth_sequence.h"
 #include "errors.h"
 #include "input_file.h"
+#include "kitti_sequence.h"
 #include "local_maps.h"
 #include "output_folder.h"
 #include "pcd_sequence.h"
 #include "pictures.h"
 #include "progress_bar.h"
 #include "result_writers.h"
+#include "text_fields.h"
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/maps/topological_map.h>
@@ -16,6 +19,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,8 +54,15 @@ std::string detectFormat(const PartitionArgs& args) {
   if (args.format == "pcd" && !folder)
     throw io::UsageError(args.input + ": --format pcd needs a folder of .pcd files");
   if (args.format == "carmen" && folder) throw io::UsageError(args.input + ": --format carmen needs a log file");
+  if (args.format != "auto" && args.format != "carmen" && !folder)
+    throw io::UsageError(args.input + ": --format " + args.format + " needs a folder");
   if (args.format != "auto") return args.format;
-  if (folder) return "pcd";
+  if (folder) {
+    if (const auto layout = io::detectDepthLayout(args.input)) return io::toString(*layout);
+    if (io::isKittiFolder(args.input) || (args.poses && fs::is_directory(fs::path(args.input) / "velodyne", ec)))
+      return "kitti";
+    return "pcd";
+  }
   if (fs::path(args.input).extension() == ".pcd")
     throw io::UsageError(args.input + ": a single PCD file; give the folder holding the sequence");
   return "carmen";
@@ -59,9 +70,16 @@ std::string detectFormat(const PartitionArgs& args) {
 
 void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences only");
-  if (format == "pcd" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
+  const bool depth = format == "tum-rgbd" || format == "redwood";
+  if (!depth && (args.intrinsics || args.depth_scale || args.depth_max || args.stride))
+    throw io::UsageError("--intrinsics, --depth-scale, --depth-max and --stride apply to depth images only");
+  if (format != "pcd" && format != "tum-rgbd" && args.max_time_difference)
+    throw io::UsageError("--max-time-difference applies to TUM poses matched by timestamp (tum-rgbd, pcd)");
+  if (format != "pcd" && args.pose_format)
+    throw io::UsageError("--pose-format applies to PCD sequences (depth images and KITTI have their own)");
+  if (format != "carmen" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
-  if (format == "pcd" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
+  if (format != "carmen" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
 }
 
 /// Warnings go to stderr as they happen and into partition.json.
@@ -302,18 +320,109 @@ int runCarmen(const PartitionArgs& args) {
   return runPipeline(args, std::move(observations), std::move(input));
 }
 
+/// A PCD file named by a timestamp ("1305031102.175304.pcd"): its stamp.
+std::optional<double> stampOfName(const std::string& file) {
+  const std::string stem = std::filesystem::path(file).stem().string();
+  if (stem.find('.') == std::string::npos) return std::nullopt;  // 000012.pcd is an index, not a time
+  const auto value = io::toDouble(stem);
+  if (!value || !std::isfinite(*value)) return std::nullopt;
+  return value;
+}
+
 template <typename PointT>
-int runPcd(const PartitionArgs& args, const std::vector<std::string>& files, io::PointKind kind,
-           Clock::time_point start) {
+int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointKind kind, Clock::time_point start) {
   std::optional<std::vector<Eigen::Isometry3d>> poses;
-  if (args.poses) poses = io::readPoses(*args.poses, args.pose_format);
+  std::optional<io::PoseFormat> pose_format = args.pose_format;
+  std::string matched = "line order";
+  std::vector<std::string> warnings;
+  if (args.poses) {
+    const std::string bytes = io::readInputBytes(*args.poses, "poses file");
+    const std::string name = io::inputName(*args.poses);
+    if (!pose_format) pose_format = io::detectPoseFormat(bytes, name);
+    std::vector<std::optional<double>> stamps;
+    for (const auto& file : files) stamps.push_back(stampOfName(file));
+    const bool stamped = *pose_format == io::PoseFormat::Tum &&
+                         std::all_of(stamps.begin(), stamps.end(), [](const auto& t) { return t.has_value(); });
+    if (stamped) {  // match each cloud to the pose nearest its stamp
+      matched = "timestamp";
+      const double tolerance = args.max_time_difference.value_or(0.02);
+      std::vector<io::StampedPose> stamped_poses = io::parseStampedPoses(bytes, name);
+      std::stable_sort(stamped_poses.begin(), stamped_poses.end(),
+                       [](const io::StampedPose& a, const io::StampedPose& b) { return a.stamp < b.stamp; });
+      std::vector<std::string> kept;
+      poses.emplace();
+      for (std::size_t k = 0; k < files.size(); ++k)
+        if (const auto match = io::nearestStamp(stamped_poses, *stamps[k], tolerance)) {
+          kept.push_back(files[k]);
+          poses->push_back(stamped_poses[*match].pose);
+        }
+      if (kept.empty())
+        throw io::InputError(name + ": no pose within " + std::to_string(tolerance) + " s of any of the " +
+                             std::to_string(files.size()) + " PCD files' timestamps (--max-time-difference)");
+      if (kept.size() < files.size())
+        warnings.push_back(std::to_string(files.size() - kept.size()) + " of " + std::to_string(files.size()) +
+                           " PCD files have no pose in " + name + " within " + std::to_string(tolerance) +
+                           " s of the timestamp in their name: skipped");
+      files = std::move(kept);
+    } else {
+      if (args.max_time_difference)
+        throw io::UsageError("--max-time-difference: the PCD files are not named by timestamps (or the poses are "
+                             "not TUM): poses are matched by line order");
+      poses = io::parsePoses(bytes, name, *pose_format);
+    }
+  }
   io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""));
   InputRecord input;
   input.format = "pcd";
   input.labels = files;
   input.parameters = {{"poses", args.poses ? nlohmann::json(*args.poses) : nlohmann::json("VIEWPOINT")},
-                      {"pose_format", args.poses ? nlohmann::json(io::toString(args.pose_format)) : nlohmann::json()},
+                      {"pose_format", pose_format ? nlohmann::json(io::toString(*pose_format)) : nlohmann::json()},
                       {"point_type", io::toString(kind)}};
+  if (args.poses) input.parameters["poses_matched_by"] = matched;
+  input.warnings = std::move(warnings);
+  for (auto& w : sequence.warnings) input.warnings.push_back(std::move(w));
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(sequence.observations), std::move(input));
+}
+
+int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
+  const auto start = Clock::now();
+  io::DepthOptions options;
+  if (args.intrinsics) options.intrinsics = io::parseIntrinsics(*args.intrinsics);
+  options.depth_scale = args.depth_scale;
+  options.max_depth = args.depth_max;
+  options.stride = args.stride.value_or(1);
+  options.max_time_difference = args.max_time_difference.value_or(0.02);
+  options.poses = args.poses;
+  io::DepthSequence sequence = io::loadDepthSequence(args.input, layout, options);
+  InputRecord input;
+  input.format = io::toString(layout);
+  input.labels = std::move(sequence.labels);
+  const auto& k = options.intrinsics;
+  input.parameters = {{"intrinsics", {k.fx, k.fy, k.cx, k.cy}},
+                      {"depth_scale", sequence.depth_scale},
+                      {"depth_max", args.depth_max ? nlohmann::json(*args.depth_max) : nlohmann::json()},
+                      {"stride", options.stride},
+                      {"point_type", io::toString(io::PointKind::XYZ)}};
+  if (layout == io::DepthLayout::TumRgbd) {
+    input.parameters["max_time_difference"] = options.max_time_difference;
+    input.parameters["skipped_frames"] = sequence.skipped;
+  }
+  if (args.poses) input.parameters["poses"] = *args.poses;
+  input.warnings = std::move(sequence.warnings);
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(sequence.observations), std::move(input));
+}
+
+int runKitti(const PartitionArgs& args) {
+  const auto start = Clock::now();
+  io::KittiSequence sequence = io::loadKittiSequence(args.input, args.poses);
+  InputRecord input;
+  input.format = "kitti";
+  input.labels = std::move(sequence.labels);
+  input.parameters = {{"poses", sequence.poses_file},
+                      {"calibration", sequence.calib_file},
+                      {"point_type", io::toString(io::PointKind::XYZI)}};
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
   return runPipeline(args, std::move(sequence.observations), std::move(input));
@@ -327,6 +436,9 @@ int runPartition(const PartitionArgs& args) {
   checkOptionsFit(args, format);
   io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
   if (format == "carmen") return runCarmen(args);
+  if (format == "tum-rgbd") return runDepth(args, io::DepthLayout::TumRgbd);
+  if (format == "redwood") return runDepth(args, io::DepthLayout::Redwood);
+  if (format == "kitti") return runKitti(args);
 
   const auto start = Clock::now();
   const auto files = io::listPcdFiles(args.input);

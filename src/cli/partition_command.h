@@ -18,7 +18,7 @@ namespace obsgroup::cli {
 struct PartitionArgs {
   std::string input;
   std::string output;
-  std::string format = "auto";  ///< auto, carmen or pcd
+  std::string format = "auto";  ///< auto, carmen, pcd, tum-rgbd, redwood or kitti
   // CARMEN logs
   io::LaserSource laser = io::LaserSource::Auto;
   std::optional<double> field_of_view_deg;
@@ -26,7 +26,13 @@ struct PartitionArgs {
   bool skip_bad_lines = false;  ///< a bad line is a warning (counted), not an error
   // PCD sequences
   std::optional<std::string> poses;
-  io::PoseFormat pose_format = io::PoseFormat::Tum;
+  std::optional<io::PoseFormat> pose_format;  ///< default: from the column count (8 tum, 12 kitti)
+  std::optional<double> max_time_difference;  ///< seconds; default 0.02 (TUM poses matched by timestamp)
+  // depth image sequences
+  std::optional<std::string> intrinsics;  ///< "fx,fy,cx,cy"
+  std::optional<double> depth_scale;      ///< units per metre; default from the layout
+  std::optional<double> depth_max;        ///< metres
+  std::optional<int> stride;              ///< every Nth pixel in u and v
   // the method
   /// The defaults are the settings that measured best across lasers and
   /// depth cameras with drifted poses (docs/grouping.md); `--paper` gives the

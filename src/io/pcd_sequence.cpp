@@ -25,30 +25,6 @@ std::string toString(PointKind kind) {
 
 namespace {
 
-/// Natural order: runs of digits compare as numbers.
-bool naturalLess(const std::string& a, const std::string& b) {
-  std::size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
-      std::size_t ei = i, ej = j;
-      while (ei < a.size() && std::isdigit(static_cast<unsigned char>(a[ei]))) ++ei;
-      while (ej < b.size() && std::isdigit(static_cast<unsigned char>(b[ej]))) ++ej;
-      const std::string da = a.substr(i, ei - i), db = b.substr(j, ej - j);
-      const std::string ta = da.substr(std::min(da.find_first_not_of('0'), da.size()));
-      const std::string tb = db.substr(std::min(db.find_first_not_of('0'), db.size()));
-      if (ta.size() != tb.size()) return ta.size() < tb.size();
-      if (ta != tb) return ta < tb;
-      i = ei;
-      j = ej;
-    } else {
-      if (a[i] != b[j]) return a[i] < b[j];
-      ++i;
-      ++j;
-    }
-  }
-  return a.size() - i < b.size() - j || (a.size() - i == b.size() - j && a < b);
-}
-
 /// Runs a PCL reader call: its error status and whatever it throws on a
 /// malformed file (std::out_of_range from readHeader, for one) become an
 /// InputError naming the file.
@@ -96,6 +72,29 @@ bool isIdentity(const Eigen::Isometry3d& pose) {
 }
 
 }  // namespace
+
+bool naturalLess(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t ei = i, ej = j;
+      while (ei < a.size() && std::isdigit(static_cast<unsigned char>(a[ei]))) ++ei;
+      while (ej < b.size() && std::isdigit(static_cast<unsigned char>(b[ej]))) ++ej;
+      const std::string da = a.substr(i, ei - i), db = b.substr(j, ej - j);
+      const std::string ta = da.substr(std::min(da.find_first_not_of('0'), da.size()));
+      const std::string tb = db.substr(std::min(db.find_first_not_of('0'), db.size()));
+      if (ta.size() != tb.size()) return ta.size() < tb.size();
+      if (ta != tb) return ta < tb;
+      i = ei;
+      j = ej;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j || (a.size() - i == b.size() - j && a < b);
+}
 
 std::vector<std::string> listPcdFiles(const std::string& folder) {
   namespace fs = std::filesystem;

@@ -17,6 +17,9 @@ enum class PointKind { XYZ, XYZI, XYZRGB };
 
 std::string toString(PointKind kind);
 
+/// Natural order of file names: runs of digits compare as numbers.
+bool naturalLess(const std::string& a, const std::string& b);
+
 /// The .pcd files of a folder in natural name order (2.pcd before 10.pcd).
 /// Throws InputError if the folder does not exist or holds no PCD file.
 std::vector<std::string> listPcdFiles(const std::string& folder);

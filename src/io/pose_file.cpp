@@ -4,6 +4,7 @@
 #include "input_file.h"
 #include "text_fields.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -61,14 +62,16 @@ std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat for
   return parsePoses(readInputBytes(path, "poses file"), inputName(path), format);
 }
 
-std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format) {
-  if (isGzip(content)) return parsePoses(gunzip(content, path), path, format);
-  content = withoutByteOrderMark(content);
+namespace {
+
+/// Every pose line of `content` (gzip inflated, BOM dropped): `add` receives
+/// its fields and where it is.
+template <typename Add>
+void forEachPoseLine(std::string_view content, const std::string& path, PoseFormat format, Add&& add) {
   const std::size_t expected = format == PoseFormat::Tum ? 8 : 12;
   const std::string layout = format == PoseFormat::Tum ? "TUM: timestamp tx ty tz qx qy qz qw"
                                                        : "KITTI: 12 values of a 3x4 [R|t] matrix";
-  std::vector<Eigen::Isometry3d> poses;
-  std::size_t number = 0;
+  std::size_t number = 0, count = 0;
   for (std::size_t start = 0; start < content.size();) {
     std::size_t end = content.find('\n', start);
     if (end == std::string_view::npos) end = content.size();
@@ -82,10 +85,74 @@ std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::s
       throw inputError(path, number,
                        "a pose line has " + std::to_string(fields.size()) + " values, expected " +
                            std::to_string(expected) + " (" + layout + ")" + otherFormatHint(fields.size(), format));
-    poses.push_back(format == PoseFormat::Tum ? parseTum(fields, where) : parseKitti(fields, where));
+    add(fields, where);
+    ++count;
   }
-  if (poses.empty()) throw InputError(path + ": the poses file holds no pose");
+  if (count == 0) throw InputError(path + ": the poses file holds no pose");
+}
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format) {
+  if (isGzip(content)) return parsePoses(gunzip(content, path), path, format);
+  content = withoutByteOrderMark(content);
+  std::vector<Eigen::Isometry3d> poses;
+  forEachPoseLine(content, path, format, [&](const std::vector<std::string_view>& fields, const LineRef& where) {
+    poses.push_back(format == PoseFormat::Tum ? parseTum(fields, where) : parseKitti(fields, where));
+  });
   return poses;
+}
+
+std::vector<StampedPose> readStampedPoses(const std::string& path) {
+  return parseStampedPoses(readInputBytes(path, "poses file"), inputName(path));
+}
+
+std::vector<StampedPose> parseStampedPoses(std::string_view content, const std::string& path) {
+  if (isGzip(content)) return parseStampedPoses(gunzip(content, path), path);
+  content = withoutByteOrderMark(content);
+  std::vector<StampedPose> poses;
+  forEachPoseLine(content, path, PoseFormat::Tum, [&](const std::vector<std::string_view>& fields, const LineRef& where) {
+    poses.push_back({parseFinite(fields[0], where, "timestamp"), parseTum(fields, where)});
+  });
+  return poses;
+}
+
+PoseFormat detectPoseFormat(std::string_view content, const std::string& path) {
+  if (isGzip(content)) return detectPoseFormat(gunzip(content, path), path);
+  content = withoutByteOrderMark(content);
+  std::size_t number = 0;
+  for (std::size_t start = 0; start < content.size();) {
+    std::size_t end = content.find('\n', start);
+    if (end == std::string_view::npos) end = content.size();
+    const auto fields = splitFields(content.substr(start, end - start));
+    start = end + 1;
+    ++number;
+    if (fields.empty() || fields[0].front() == '#') continue;
+    if (fields.size() == 8) return PoseFormat::Tum;
+    if (fields.size() == 12) return PoseFormat::Kitti;
+    throw inputError(path, number,
+                     "a pose line has " + std::to_string(fields.size()) +
+                         " values: neither TUM (8: timestamp tx ty tz qx qy qz qw) nor KITTI (12: a 3x4 [R|t]); "
+                         "--pose-format tells which");
+  }
+  throw InputError(path + ": the poses file holds no pose");
+}
+
+std::optional<std::size_t> nearestStamp(const std::vector<StampedPose>& poses, double stamp, double tolerance) {
+  const auto after = std::lower_bound(poses.begin(), poses.end(), stamp,
+                                      [](const StampedPose& p, double t) { return p.stamp < t; });
+  std::optional<std::size_t> best;
+  double best_gap = tolerance;
+  const auto consider = [&](std::vector<StampedPose>::const_iterator it) {
+    const double gap = std::abs(it->stamp - stamp);
+    if (gap <= best_gap) {
+      best_gap = gap;
+      best = std::size_t(it - poses.begin());
+    }
+  };
+  if (after != poses.end()) consider(after);
+  if (after != poses.begin()) consider(after - 1);
+  return best;
 }
 
 }  // namespace obsgroup::io

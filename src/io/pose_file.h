@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,6 +28,24 @@ std::vector<Eigen::Isometry3d> readPoses(const std::string& path, PoseFormat for
 
 /// The same from a file's content (gzipped or not) already in memory; `path` names it in errors.
 std::vector<Eigen::Isometry3d> parsePoses(std::string_view content, const std::string& path, PoseFormat format);
+
+/// A pose and the time it was taken at (a TUM line's timestamp).
+struct StampedPose {
+  double stamp = 0.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+
+/// The TUM poses of a file with their timestamps, in file order.
+std::vector<StampedPose> readStampedPoses(const std::string& path);
+std::vector<StampedPose> parseStampedPoses(std::string_view content, const std::string& path);
+
+/// The format told by the number of values on the first pose line: 8 TUM,
+/// 12 KITTI. Throws InputError naming the file and the line otherwise.
+PoseFormat detectPoseFormat(std::string_view content, const std::string& path);
+
+/// The index of the pose nearest `stamp` within `tolerance` seconds, or
+/// nothing. `poses` sorted by stamp.
+std::optional<std::size_t> nearestStamp(const std::vector<StampedPose>& poses, double stamp, double tolerance);
 
 /// The rotation of a quaternion given as (w, x, y, z), normalised; throws
 /// std::invalid_argument when its norm is not within 1% of 1.
