@@ -103,8 +103,14 @@ TEST(ObservationGrouping, PartitionOptionsSetLaterKeepTheThreadsAndTheInterruptF
   g.setInterruptFlag(&flag);
   PartitionOptions options;
   options.ncut_threshold = 0.5;
+  options.threads = 7;  // stored once, by setNumberOfThreads: ignored here
   g.setPartitionOptions(options);
   EXPECT_EQ(g.getPartitionOptions().threads, 1);
   EXPECT_EQ(g.getPartitionOptions().interrupt, &flag);
+  EXPECT_EQ(g.getNumberOfThreads(), 1);
   EXPECT_EQ(g.getNcutThreshold(), 0.5);
+  // Set after the options, the threads reach both stages.
+  g.setNumberOfThreads(2);
+  EXPECT_EQ(g.getPartitionOptions().threads, 2);
+  EXPECT_EQ(g.getSensedSpaceOverlap().getNumberOfThreads(), 2);
 }

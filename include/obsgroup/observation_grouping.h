@@ -85,18 +85,13 @@ class ObservationGrouping {
   void setSearchMethod(const SearchMethodPtr& search) { overlap_.setSearchMethod(search); }
   SearchMethodPtr getSearchMethod() const { return overlap_.getSearchMethod(); }
   /// Threads for the overlap and the partition; the result does not depend on it.
-  void setNumberOfThreads(int threads) {
-    overlap_.setNumberOfThreads(threads);
-    options_.threads = threads;
-  }
+  /// Stored once, in the overlap stage; the partition is given the same.
+  void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
   int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
   void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
   /// A flag polled during compute() (see interrupt.h); when it is set,
   /// compute() stops and throws Interrupted. Not owned.
-  void setInterruptFlag(const InterruptFlag* flag) {
-    overlap_.setInterruptFlag(flag);
-    options_.interrupt = flag;
-  }
+  void setInterruptFlag(const InterruptFlag* flag) { overlap_.setInterruptFlag(flag); }
 
   // --- graph and partition (sec. II, III) ---
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
@@ -116,14 +111,15 @@ class ObservationGrouping {
   /// are the ones setNumberOfThreads and setInterruptFlag gave (for the
   /// overlap and the partition alike): those of `options` are ignored, so
   /// that setting the options later does not undo them.
-  void setPartitionOptions(const PartitionOptions& options) {
-    const int threads = options_.threads;
-    const InterruptFlag* interrupt = options_.interrupt;
-    options_ = options;
-    options_.threads = threads;
-    options_.interrupt = interrupt;
+  void setPartitionOptions(const PartitionOptions& options) { options_ = options; }
+  /// The options compute() partitions with: those set, with this object's
+  /// thread count and interrupt flag.
+  PartitionOptions getPartitionOptions() const {
+    PartitionOptions options = options_;
+    options.threads = overlap_.getNumberOfThreads();
+    options.interrupt = overlap_.getInterruptFlag();
+    return options;
   }
-  const PartitionOptions& getPartitionOptions() const { return options_; }
 
   /// Computes the overlap, builds W and partitions it. Throws
   /// std::invalid_argument on bad parameters or observations.

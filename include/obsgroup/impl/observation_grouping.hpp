@@ -48,7 +48,7 @@ Partition ObservationGrouping<PointT>::compute() {
   W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, diagonal_);
   timings_.graph_s = seconds_since(start);
   start = Clock::now();
-  Partition partition = recursivePartition(W_, options_);
+  Partition partition = recursivePartition(W_, getPartitionOptions());
   timings_.partition_s = seconds_since(start);
 
   warnings_.clear();
