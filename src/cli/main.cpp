@@ -36,12 +36,14 @@ void catchInterrupts() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
-void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
-  using namespace obsgroup;
-  using cli::choices;
-  using cli::finiteNumber;
-  using cli::oneOf;
-  using cli::wholeNumber;
+using namespace obsgroup;
+using cli::choices;
+using cli::finiteNumber;
+using cli::oneOf;
+using cli::wholeNumber;
+
+/// INPUT, -o and --format.
+void addInputOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("input", args.input,
                      "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input), folder of .pcd files, "
                      "depth images (TUM RGB-D, Redwood) or KITTI odometry")
@@ -50,7 +52,10 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   command.add_option("--format", args.format, "input format (default: from the input)")
       ->check(CLI::IsMember({"auto", "carmen", "pcd", "tum-rgbd", "redwood", "kitti"}))
       ->option_text("auto|carmen|pcd|tum-rgbd|redwood|kitti");
+}
 
+/// Options of CARMEN logs.
+void addCarmenOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--laser", args.laser, "CARMEN: which laser messages: FLASER, RLASER or ROBOTLASER1 (default: auto, "
                                             "ROBOTLASER1 if any, else FLASER, else RLASER)")
       ->transform(oneOf(io::kLaserSourceNames))
@@ -68,7 +73,10 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   command.add_flag("--skip-bad-lines", args.skip_bad_lines,
                    "CARMEN: skip malformed lines (a truncated last line, say), counted in one warning")
       ->group("CARMEN logs");
+}
 
+/// Options of PCD sequences and pose files.
+void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--poses", args.poses,
                      "PCD: poses file, one line per cloud, or matched by timestamp when the files are named by one "
                      "(default: each PCD's VIEWPOINT); depth images, KITTI: instead of the folder's")
@@ -82,7 +90,10 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
                      "TUM poses matched by timestamp: most seconds between a frame and its pose (default: 0.02)")
       ->check(finiteNumber(0.0))
       ->group("PCD sequences");
+}
 
+/// Options of depth image sequences.
+void addDepthOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--intrinsics", args.intrinsics, "depth images: pinhole fx,fy,cx,cy in pixels (default: "
                                                       "525,525,319.5,239.5)")
       ->option_text("FX,FY,CX,CY")
@@ -97,7 +108,10 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   command.add_option("--stride", args.stride, "depth images: every Nth pixel in each direction (default: 1)")
       ->check(wholeNumber(1))
       ->group("Depth images");
+}
 
+/// The sensed-space model and the partition (the paper's sec. II-III).
+void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--sso", args.sso,
                      "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "
                      "visibility (cells visible from the pose) (default: " + toString(args.sso) + ")")
@@ -157,6 +171,10 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   command.add_option("--max-depth", args.max_depth, "do not bisect deeper than this (default: no limit)")
       ->check(wholeNumber(0))
       ->group("Method");
+}
+
+/// Threads, refinement, local maps and the outputs.
+void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--threads", args.threads, "threads (0 = all cores); results do not depend on it")
       ->check(wholeNumber(0))
       ->capture_default_str();
@@ -172,6 +190,15 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr");
   command.add_flag("--no-pictures", args.no_pictures,
                    "do not draw map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png");
+}
+
+void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  addInputOptions(command, args);
+  addCarmenOptions(command, args);
+  addPcdOptions(command, args);
+  addDepthOptions(command, args);
+  addMethodOptions(command, args);
+  addRunOptions(command, args);
 }
 
 /// CLI11's messages with the command's prefix, and where to read more.
@@ -243,7 +270,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1, 1);
   app.failure_message(failureMessage);
   obsgroup::cli::PartitionArgs args;
-  CLI::App* partition = app.add_subcommand("partition", "group the observations of a log or a PCD sequence");
+  CLI::App* partition = app.add_subcommand("partition", "group the observations of a laser log, a PCD sequence, depth images or KITTI scans");
   addPartitionOptions(*partition, args);
 
   const auto usage = [](const std::string& message) {
