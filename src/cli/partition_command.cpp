@@ -225,28 +225,36 @@ nlohmann::json methodParameters(const PartitionArgs& args, double diagonal, doub
   return p;
 }
 
-template <typename PointT>
-int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
-  Warnings warn(args.quiet);
-  for (const auto& w : input.warnings) warn(w);
-  ObservationGrouping<PointT> grouping;
-  const Partition partition = groupObservations(args, grouping, observations, input, warn);
-  const MapsOfRun<PointT> maps = buildMaps(args, observations, partition, grouping.getWeightMatrix(), warn);
+/// Seconds spent writing, pictures included.
+struct OutputTimes {
+  double outputs_s = 0.0, pictures_s = 0.0;
+  std::size_t map_points = 0;
+};
 
-  const auto outputs_start = Clock::now();
-  io::OutputFolder out(args.output, args.force, args.interrupt);
-  const std::size_t map_points = io::writeLocalMaps(out, maps.maps, args.threads);
+template <typename PointT>
+OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
+                         const ObservationGrouping<PointT>& grouping, const std::vector<Observation<PointT>>& observations,
+                         const Partition& partition, const MapsOfRun<PointT>& maps) {
+  const auto start = Clock::now();
+  OutputTimes t;
+  t.map_points = io::writeLocalMaps(out, maps.maps, args.threads);
   out.writeText("topology.json", io::topologyJson(maps.topology));
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
-  double pictures_s = 0.0;
   if (args.pictures) {
     const auto pictures_start = Clock::now();
     drawPictures(args, out, grouping, observations, partition, maps);
-    pictures_s = secondsSince(pictures_start);
+    t.pictures_s = secondsSince(pictures_start);
   }
-  const double outputs_s = secondsSince(outputs_start);
+  t.outputs_s = secondsSince(start);
+  return t;
+}
 
+/// What partition.json records besides the groups and the split tree.
+template <typename PointT>
+io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, const ObservationGrouping<PointT>& grouping,
+                        const Partition& partition, const MapsOfRun<PointT>& maps, const OutputTimes& written,
+                        const Warnings& warn) {
   const auto& overlap = grouping.getOverlap();
   std::size_t points = 0;
   for (std::size_t m : overlap.points_per_observation) points += m;
@@ -260,30 +268,47 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
                     {"point_tests", overlap.point_tests},
                     {"edges", overlap.pairs.size()},
                     {"groups", partition.groups.size()},
-                    {"local_map_points", map_points},
+                    {"local_map_points", written.map_points},
                     {"refined_members", maps.refinement.moved},
                     {"kept_members", maps.refinement.members - maps.refinement.moved}};
   const auto& t = grouping.getTimings();
   run.warnings = warn.all();
   run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s},     {"graph", t.graph_s},
-                  {"partition", t.partition_s}, {"local_maps", maps.seconds}, {"outputs", outputs_s},
-                  {"pictures", pictures_s},     {"threads", threadCount(args.threads)}};
+                  {"partition", t.partition_s}, {"local_maps", maps.seconds}, {"outputs", written.outputs_s},
+                  {"pictures", written.pictures_s}, {"threads", threadCount(args.threads)}};
+  return run;
+}
+
+void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
+  const auto plural = [](std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); };
+  const auto& s = run.statistics;
+  const auto& t = run.timing_s;
+  std::fprintf(stderr,
+               "obsgroup: %s (%s), %s evaluated, %zu overlapping, %s\n"
+               "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
+               " (pictures %.2f s)\n"
+               "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
+               plural(observations, "observation").c_str(), plural(s.at("points").get<std::size_t>(), "point").c_str(),
+               plural(s.at("pairs_evaluated").get<std::size_t>(), "pair").c_str(), s.at("edges").get<std::size_t>(),
+               plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(), t.at("overlap").get<double>(),
+               t.at("graph").get<double>(), t.at("partition").get<double>(), t.at("local_maps").get<double>(),
+               t.at("outputs").get<double>(), t.at("pictures").get<double>(), args.output.c_str(),
+               args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
+}
+
+template <typename PointT>
+int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
+  Warnings warn(args.quiet);
+  for (const auto& w : input.warnings) warn(w);
+  ObservationGrouping<PointT> grouping;
+  const Partition partition = groupObservations(args, grouping, observations, input, warn);
+  const MapsOfRun<PointT> maps = buildMaps(args, observations, partition, grouping.getWeightMatrix(), warn);
+  io::OutputFolder out(args.output, args.force, args.interrupt);
+  const OutputTimes written = writeResults(args, out, grouping, observations, partition, maps);
+  const io::RunRecord run = runRecord(args, input, grouping, partition, maps, written, warn);
   out.writeText("partition.json", io::partitionJson(partition, run));
   out.commit();
-
-  if (!args.quiet) {
-    const auto plural = [](std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); };
-    std::fprintf(stderr,
-                 "obsgroup: %s (%s), %s evaluated, %zu overlapping, %s\n"
-                 "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
-                 " (pictures %.2f s)\n"
-                 "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
-                 plural(observations.size(), "observation").c_str(), plural(points, "point").c_str(),
-                 plural(overlap.pairs_evaluated, "pair").c_str(), overlap.pairs.size(),
-                 plural(partition.groups.size(), "group").c_str(), input.load_s, t.overlap_s, t.graph_s,
-                 t.partition_s, maps.seconds, outputs_s, pictures_s, args.output.c_str(),
-                 args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
-  }
+  if (!args.quiet) printSummary(args, run, observations.size());
   return 0;
 }
 

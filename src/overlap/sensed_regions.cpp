@@ -541,10 +541,18 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   return regions;
 }
 
-/// For each observation, the other observations holding its cells and how
-/// many. Consumes `lists`: each observation's keys are freed once entered,
-/// so the regions are never held twice.
-MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int threads, const InterruptFlag* interrupt) {
+/// Which observations hold each cell, and which cells each observation
+/// holds: cell c is held by watchers[cell_start[c], cell_start[c+1]);
+/// observation i's cells, ascending, are cells_of[offsets[i], offsets[i+1]).
+struct SharedCells {
+  std::vector<std::size_t> offsets, cell_start;
+  std::vector<std::uint32_t> watchers, cells_of;
+};
+
+/// Consumes `lists`: each observation's keys are freed once entered, so the
+/// regions are never held twice.
+SharedCells indexSharedCells(std::vector<std::vector<std::uint64_t>>& lists, int threads,
+                             const InterruptFlag* interrupt) {
   const int n = static_cast<int>(lists.size());
   // Group the (cell, observation) entries by cell: one sort of all of them.
   // Packed to 12 bytes: at 100,000 observations they are the largest array.
@@ -557,32 +565,35 @@ MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int thre
     }
   };
 #pragma pack(pop)
-  std::vector<std::size_t> offsets{0};
-  for (const auto& list : lists) offsets.push_back(offsets.back() + list.size());
-  std::vector<Entry> entries(offsets.back());
+  SharedCells shared;
+  shared.offsets = {0};
+  for (const auto& list : lists) shared.offsets.push_back(shared.offsets.back() + list.size());
+  std::vector<Entry> entries(shared.offsets.back());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
   for (int i = 0; i < n; ++i) {
-    for (std::size_t k = 0; k < lists[i].size(); ++k) entries[offsets[i] + k] = {lists[i][k], std::uint32_t(i)};
+    for (std::size_t k = 0; k < lists[i].size(); ++k) entries[shared.offsets[i] + k] = {lists[i][k], std::uint32_t(i)};
     std::vector<std::uint64_t>().swap(lists[i]);
   }
   throwIfInterrupted(interrupt);
   sortInParallel(entries);  // distinct entries
   throwIfInterrupted(interrupt);
-
-  // Cell c holds the observations watchers[cell_start[c], cell_start[c+1]);
-  // observation i's cells, ascending, are cells_of[offsets[i], ...).
-  std::vector<std::size_t> cell_start;
-  std::vector<std::uint32_t> watchers(entries.size());
-  std::vector<std::uint32_t> cells_of(entries.size());
-  std::vector<std::size_t> fill(offsets.begin(), offsets.end() - 1);
+  shared.watchers.resize(entries.size());
+  shared.cells_of.resize(entries.size());
+  std::vector<std::size_t> fill(shared.offsets.begin(), shared.offsets.end() - 1);
   for (std::size_t k = 0; k < entries.size(); ++k) {
-    if (k == 0 || entries[k].key != entries[k - 1].key) cell_start.push_back(k);
-    watchers[k] = entries[k].observation;
-    cells_of[fill[entries[k].observation]++] = std::uint32_t(cell_start.size() - 1);
+    if (k == 0 || entries[k].key != entries[k - 1].key) shared.cell_start.push_back(k);
+    shared.watchers[k] = entries[k].observation;
+    shared.cells_of[fill[entries[k].observation]++] = std::uint32_t(shared.cell_start.size() - 1);
   }
-  cell_start.push_back(entries.size());
-  std::vector<Entry>().swap(entries);
+  shared.cell_start.push_back(entries.size());
+  return shared;
+}
 
+/// For each observation, the other observations holding its cells and how
+/// many. Consumes `lists`.
+MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int threads, const InterruptFlag* interrupt) {
+  const int n = static_cast<int>(lists.size());
+  const SharedCells cells = indexSharedCells(lists, threads, interrupt);
   MatchCounts out;
   out.rows.resize(n);
   std::uint64_t pairs = 0, tests = 0;
@@ -593,13 +604,13 @@ MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int thre
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
       if (interruptRequested(interrupt)) continue;
-      for (std::size_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-        const std::uint32_t c = cells_of[k];
-        for (std::size_t w = cell_start[c]; w < cell_start[c + 1]; ++w) {
-          const std::uint32_t j = watchers[w];
+      for (std::size_t k = cells.offsets[i]; k < cells.offsets[i + 1]; ++k) {
+        const std::uint32_t c = cells.cells_of[k];
+        for (std::size_t w = cells.cell_start[c]; w < cells.cell_start[c + 1]; ++w) {
+          const std::uint32_t j = cells.watchers[w];
           if (shared[j]++ == 0) touched.push_back(int(j));
         }
-        tests += cell_start[c + 1] - cell_start[c];
+        tests += cells.cell_start[c + 1] - cells.cell_start[c];
       }
       std::sort(touched.begin(), touched.end());
       auto& row = out.rows[i];
