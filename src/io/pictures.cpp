@@ -1,5 +1,8 @@
 #include "pictures.h"
 
+#include <obsgroup/cloud/finite_points.h>
+#include <obsgroup/common/parallel_for.h>
+
 #include <cairo-svg.h>
 #include <cairo.h>
 #include <pcl/point_types.h>
@@ -688,25 +691,13 @@ std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std:
 template <typename PointT>
 void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads,
                            const std::vector<int>& colours) {
-  const int n = static_cast<int>(maps.size());
-  std::vector<std::exception_ptr> failures(maps.size());
-#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) schedule(dynamic, 1)
-  for (int g = 0; g < n; ++g) {
-    try {
-      std::vector<Eigen::Vector3f> points;
-      if (maps[g].cloud) {
-        points.reserve(maps[g].cloud->size());
-        for (const PointT& p : maps[g].cloud->points)
-          if (std::isfinite(p.x) && std::isfinite(p.y)) points.emplace_back(p.x, p.y, p.z);
-      }
-      const int colour = std::size_t(g) < colours.size() ? colours[g] : g;
-      writeLocalMapPicture(out, g, maps[g].frame, points, paletteColour(colour));
-    } catch (...) {
-      failures[g] = std::current_exception();
-    }
-  }
-  for (const auto& failure : failures)
-    if (failure) std::rethrow_exception(failure);
+  parallelFor(maps.size(), threads, [&](std::size_t g) {
+    std::vector<Eigen::Vector3f> points;
+    if (maps[g].cloud)
+      for (const PointT& p : finitePoints(*maps[g].cloud).points) points.emplace_back(p.x, p.y, p.z);
+    const int colour = g < colours.size() ? colours[g] : static_cast<int>(g);
+    writeLocalMapPicture(out, static_cast<int>(g), maps[g].frame, points, paletteColour(colour));
+  });
 }
 
 template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int,

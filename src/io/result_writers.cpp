@@ -1,5 +1,7 @@
 #include "result_writers.h"
 
+#include <obsgroup/common/parallel_for.h>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -40,8 +42,7 @@ template <typename Item>
 std::string arrayPerLine(std::size_t size, const Item& item) {
   if (size == 0) return "[]";
   std::vector<std::string> lines(size);
-#pragma omp parallel for schedule(dynamic, 64)
-  for (std::size_t k = 0; k < size; ++k) lines[k] = item(k).dump();
+  parallelFor(size, 0, 64, [&](std::size_t k) { lines[k] = item(k).dump(); });
   std::size_t length = 4;
   for (const auto& line : lines) length += line.size() + 6;
   std::string out;
