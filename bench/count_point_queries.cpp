@@ -8,8 +8,8 @@
 //
 //   count_point_queries INPUT DELTA [VOXEL]   INPUT: a CARMEN log or a folder of PCD files
 
-#include "carmen_reader.h"
-#include "pcd_sequence.h"
+#include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/pcd_sequence.h>
 
 #include <obsgroup/overlap/sensed_space_overlap.h>
 #include <obsgroup/overlap/world_points.h>

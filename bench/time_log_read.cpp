@@ -1,8 +1,8 @@
 // Seconds to read a CARMEN log with readCarmenLog, the best of REPEATS runs:
 //   time_log_read LOG [REPEATS=3] [THREADS=0]
 // Compare a log with its gzipped copy: gzip -k LOG && time_log_read LOG.gz
-#include "carmen_reader.h"
-#include "errors.h"
+#include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/errors.h>
 
 #include <algorithm>
 #include <chrono>

@@ -37,6 +37,16 @@ macro(obsgroup_find_pcl)
   unset(_obsgroup_pcl_extras)
 endmacro()
 
+# obsgroup::io (the readers): PCL's io, zlib (gzip input), libpng (depth
+# images) and, when installed, libdeflate (a faster inflate).
+macro(obsgroup_find_io_dependencies)
+  obsgroup_find_pcl(1.10 REQUIRED COMPONENTS common io)
+  find_package(ZLIB REQUIRED)
+  find_package(PNG REQUIRED)
+  find_package(PkgConfig REQUIRED)
+  pkg_check_modules(LIBDEFLATE QUIET IMPORTED_TARGET libdeflate)
+endmacro()
+
 # obsgroup::obsgroup (the PCL templates, local maps): the core's and PCL's.
 macro(obsgroup_find_pcl_dependencies)
   obsgroup_find_pcl(1.10 REQUIRED COMPONENTS common kdtree search filters registration)

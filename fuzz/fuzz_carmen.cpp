@@ -1,7 +1,7 @@
 // libFuzzer target: the CARMEN log reader on arbitrary bytes, with every
 // laser choice and with and without the geometry options.
-#include "carmen_reader.h"
-#include "errors.h"
+#include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/errors.h>
 
 #include <cmath>
 #include <cstdint>

@@ -1,7 +1,7 @@
 // libFuzzer target: the depth PNG decoder (libpng) and the back-projection
 // on arbitrary bytes.
-#include "depth_sequence.h"
-#include "errors.h"
+#include <obsgroup/io/depth_sequence.h>
+#include <obsgroup/io/errors.h>
 
 #include <cmath>
 #include <cstdint>

@@ -1,8 +1,8 @@
 // libFuzzer target: the PCD-folder loader, PCL's own PCD reader included,
 // on arbitrary file contents. The bytes are written to a one-file folder,
 // as the command would find them.
-#include "errors.h"
-#include "pcd_sequence.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/pcd_sequence.h>
 
 #include <pcl/point_types.h>
 

@@ -1,6 +1,6 @@
 // libFuzzer target: the TUM and KITTI trajectory readers on arbitrary bytes.
-#include "errors.h"
-#include "pose_file.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/pose_file.h>
 
 #include <cmath>
 #include <cstdint>

@@ -1,11 +1,11 @@
 // The readers on their own: in-memory parsing, and the inputs that fuzzing
 // found mishandled, each pinned with its expected outcome.
-#include "carmen_reader.h"
-#include "depth_sequence.h"
-#include "errors.h"
-#include "kitti_sequence.h"
-#include "pcd_sequence.h"
-#include "pose_file.h"
+#include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/depth_sequence.h>
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/kitti_sequence.h>
+#include <obsgroup/io/pcd_sequence.h>
+#include <obsgroup/io/pose_file.h>
 #include "png_writer.h"
 #include "temp_folder.h"
 

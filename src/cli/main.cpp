@@ -4,7 +4,7 @@
 // Exit codes: 0 done, 2 usage error, 3 input error, 130 interrupted (SIGINT
 // or SIGTERM: the output folder is left as it was), 1 anything else.
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 #include "option_checks.h"
 #include "partition_command.h"
 

@@ -1,12 +1,12 @@
 #include "partition_command.h"
 
-#include "depth_sequence.h"
-#include "errors.h"
-#include "input_file.h"
-#include "kitti_sequence.h"
+#include <obsgroup/io/depth_sequence.h>
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
+#include <obsgroup/io/kitti_sequence.h>
 #include "local_maps.h"
 #include "output_folder.h"
-#include "pcd_sequence.h"
+#include <obsgroup/io/pcd_sequence.h>
 #include "pictures.h"
 #include "progress_bar.h"
 #include "result_writers.h"

@@ -2,8 +2,8 @@
 // `obsgroup partition INPUT -o OUTDIR`: read a log or a PCD sequence, group
 // its observations and write the results.
 
-#include "carmen_reader.h"
-#include "pose_file.h"
+#include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/pose_file.h>
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/overlap/sensed_regions.h>

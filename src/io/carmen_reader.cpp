@@ -1,7 +1,7 @@
-#include "carmen_reader.h"
+#include <obsgroup/io/carmen_reader.h>
 
-#include "errors.h"
-#include "input_file.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
 #include "text_fields.h"
 
 #include <obsgroup/common/parallel_for.h>

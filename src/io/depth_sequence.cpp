@@ -1,8 +1,8 @@
-#include "depth_sequence.h"
+#include <obsgroup/io/depth_sequence.h>
 
-#include "errors.h"
-#include "input_file.h"
-#include "pcd_sequence.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
+#include <obsgroup/io/pcd_sequence.h>
 #include "text_fields.h"
 
 #include <png.h>

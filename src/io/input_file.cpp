@@ -1,6 +1,6 @@
-#include "input_file.h"
+#include <obsgroup/io/input_file.h>
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 
 #include <zlib.h>
 #ifdef OBSGROUP_HAVE_LIBDEFLATE

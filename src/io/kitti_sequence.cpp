@@ -1,9 +1,9 @@
-#include "kitti_sequence.h"
+#include <obsgroup/io/kitti_sequence.h>
 
-#include "errors.h"
-#include "input_file.h"
-#include "pcd_sequence.h"
-#include "pose_file.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
+#include <obsgroup/io/pcd_sequence.h>
+#include <obsgroup/io/pose_file.h>
 #include "text_fields.h"
 
 #include <algorithm>

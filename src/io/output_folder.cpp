@@ -1,6 +1,6 @@
 #include "output_folder.h"
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 
 #include <fcntl.h>
 #include <signal.h>

@@ -1,6 +1,6 @@
 #include "pcd_header_check.h"
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 #include "text_fields.h"
 
 #include <cstdint>

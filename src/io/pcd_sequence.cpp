@@ -1,6 +1,6 @@
-#include "pcd_sequence.h"
+#include <obsgroup/io/pcd_sequence.h>
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 #include "pcd_header_check.h"
 
 #include <pcl/PCLPointCloud2.h>

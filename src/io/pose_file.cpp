@@ -1,7 +1,7 @@
-#include "pose_file.h"
+#include <obsgroup/io/pose_file.h>
 
-#include "errors.h"
-#include "input_file.h"
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
 #include "text_fields.h"
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // Splitting a text line into whitespace-separated fields and reading numbers
 // from them, with errors that name the file, the line and the field.
 
-#include "errors.h"
+#include <obsgroup/io/errors.h>
 
 #include <charconv>
 #include <cmath>

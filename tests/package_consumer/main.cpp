@@ -1,11 +1,14 @@
 // Links against an installed obsgroup: two overlapping line scans and one
-// far away give two groups, each coloured with PCL's visualization module.
+// far away give two groups, each coloured with PCL's visualization module;
+// then the same three scans as a CARMEN log, read with obsgroup::io.
+#include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/observation_grouping.h>
 
 #include <pcl/point_types.h>
 #include <pcl/visualization/point_cloud_color_handlers.h>
 
 #include <cstdio>
+#include <string>
 
 int main() {
   pcl::PointCloud<pcl::PointXYZ>::Ptr line(new pcl::PointCloud<pcl::PointXYZ>);
@@ -18,5 +21,22 @@ int main() {
   pcl::visualization::PointCloudColorHandlerCustom<pcl::PointXYZ> colour(line, 255, 0, 0);
   std::printf("package consumer: %zu groups, colour handler %s\n", partition.groups.size(),
               colour.getName().c_str());
-  return partition.groups.size() == 2 && colour.isCapable() ? 0 : 1;
+
+  // Three FLASER scans of a wall 2 m ahead, from (0,0), (0.5,0) and (0,50).
+  std::string log;
+  for (const char* pose : {"0 0 0", "0.5 0 0", "0 50 0"}) {
+    log += "FLASER 181";
+    for (int k = 0; k < 181; ++k) log += " 2.0";
+    log += std::string(" ") + pose + " " + pose + " 0 host 0\n";
+  }
+  const obsgroup::io::CarmenLog read = obsgroup::io::parseCarmenLog(log, "inline.log");
+  obsgroup::ObservationGrouping<pcl::PointXYZ> from_log;
+  for (const auto& scan : read.scans) from_log.addObservation(obsgroup::io::scanToCloud(scan), scan.laser_pose);
+  const auto log_partition = from_log.compute();
+  std::printf("package consumer: %zu scans read with obsgroup::io, %zu groups\n", read.scans.size(),
+              log_partition.groups.size());
+  return partition.groups.size() == 2 && colour.isCapable() && read.scans.size() == 3 &&
+                 log_partition.groups.size() == 2
+             ? 0
+             : 1;
 }

@@ -2,7 +2,7 @@
 // A folder of PCD files as a sequence of observations, each posed by its
 // VIEWPOINT or by a trajectory file.
 
-#include "pose_file.h"
+#include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
 

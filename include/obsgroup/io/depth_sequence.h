@@ -6,7 +6,7 @@
 // Camera frame: z forward (the optical axis), x right, y down. Pixel (u, v)
 // with depth d metres is the point ((u - cx) d / fx, (v - cy) d / fy, d).
 
-#include "pose_file.h"
+#include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
