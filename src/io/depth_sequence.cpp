@@ -270,18 +270,8 @@ std::vector<DepthFrame> readDepthList(const fs::path& folder) {
 }
 
 std::vector<std::string> listPngFiles(const fs::path& folder) {
-  std::error_code ec;
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".png" && entry.is_regular_file()) names.push_back(entry.path().filename().string());
-  }
-  if (ec) throw InputError(folder.string() + ": cannot list the folder: " + ec.message());
-  if (names.empty()) throw InputError(folder.string() + ": the folder holds no .png file");
-  std::sort(names.begin(), names.end(), naturalLess);
-  std::vector<std::string> files;
-  for (const auto& name : names) files.push_back((folder / name).string());
+  std::vector<std::string> files = filesWithExtension(folder.string(), ".png");
+  if (files.empty()) throw InputError(folder.string() + ": the folder holds no .png file");
   return files;
 }
 

@@ -75,28 +75,21 @@ KittiSequence loadKittiSequence(const std::string& folder, const std::optional<s
   std::error_code ec;
   const fs::path velodyne = dir / "velodyne";
   if (!fs::is_directory(velodyne, ec)) throw InputError(velodyne.string() + ": no such folder (KITTI: velodyne/*.bin)");
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(velodyne, ec)) {
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".bin" && entry.is_regular_file()) names.push_back(entry.path().filename().string());
-  }
-  if (ec) throw InputError(velodyne.string() + ": cannot list the folder: " + ec.message());
-  if (names.empty()) throw InputError(velodyne.string() + ": the folder holds no .bin file");
-  std::sort(names.begin(), names.end(), naturalLess);
+  const std::vector<std::string> scans = filesWithExtension(velodyne.string(), ".bin");
+  if (scans.empty()) throw InputError(velodyne.string() + ": the folder holds no .bin file");
 
   out.poses_file = poses_path.value_or((dir / "poses.txt").string());
   out.calib_file = (dir / "calib.txt").string();
   const std::vector<Eigen::Isometry3d> camera = readPoses(out.poses_file, PoseFormat::Kitti);
-  if (camera.size() != names.size())
+  if (camera.size() != scans.size())
     throw InputError(out.poses_file + ": " + std::to_string(camera.size()) + " poses for " +
-                     std::to_string(names.size()) + " velodyne scans (one pose per scan, in name order)");
+                     std::to_string(scans.size()) + " velodyne scans (one pose per scan, in name order)");
   if (!fs::is_regular_file(out.calib_file, ec))
     throw InputError(out.calib_file + ": no such file (KITTI poses are the camera's: the Tr velodyne-to-camera "
                      "line of calib.txt makes them the lidar's)");
   const Eigen::Isometry3d tr = parseKittiCalibration(readInputBytes(out.calib_file, "calibration"), out.calib_file);
-  for (std::size_t k = 0; k < names.size(); ++k) {
-    const std::string file = (velodyne / names[k]).string();
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    const std::string& file = scans[k];
     auto cloud = decodeKittiScan(readInputBytes(file, "velodyne scan"), file);
     if (cloud->empty()) out.warnings.push_back(file + ": the scan has no point; kept as an observation (a group of its own)");
     const Eigen::Isometry3d pose = camera[k] * tr;

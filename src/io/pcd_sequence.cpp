@@ -96,25 +96,32 @@ bool naturalLess(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j || (a.size() - i == b.size() - j && a < b);
 }
 
-std::vector<std::string> listPcdFiles(const std::string& folder) {
+std::vector<std::string> filesWithExtension(const std::string& folder, const std::string& extension) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::is_directory(folder, ec)) throw InputError(folder + ": not a folder");
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(folder, ec)) {
     std::string ext = entry.path().extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".pcd" && entry.is_regular_file()) names.push_back(entry.path().filename().string());
+    if (ext == extension && entry.is_regular_file()) names.push_back(entry.path().filename().string());
   }
   if (ec) throw InputError(folder + ": cannot list the folder: " + ec.message());
-  if (names.empty()) {
+  std::sort(names.begin(), names.end(), naturalLess);
+  std::vector<std::string> files;
+  for (const auto& name : names) files.push_back((fs::path(folder) / name).string());
+  return files;
+}
+
+std::vector<std::string> listPcdFiles(const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw InputError(folder + ": not a folder");
+  std::vector<std::string> files = filesWithExtension(folder, ".pcd");
+  if (files.empty()) {
     const fs::path inner = fs::path(folder) / "pcd";
     throw InputError(folder + ": the folder holds no .pcd file" +
                      (fs::is_directory(inner, ec) ? " (did you mean " + inner.string() + "?)" : std::string()));
   }
-  std::sort(names.begin(), names.end(), naturalLess);
-  std::vector<std::string> files;
-  for (const auto& name : names) files.push_back((fs::path(folder) / name).string());
   return files;
 }
 

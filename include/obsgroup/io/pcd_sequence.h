@@ -20,6 +20,11 @@ std::string toString(PointKind kind);
 /// Natural order of file names: runs of digits compare as numbers.
 bool naturalLess(const std::string& a, const std::string& b);
 
+/// The paths of the regular files of `folder` whose extension is
+/// `extension` (".pcd", any case), in natural name order; empty when there
+/// is none. Throws InputError when the folder cannot be listed.
+std::vector<std::string> filesWithExtension(const std::string& folder, const std::string& extension);
+
 /// The .pcd files of a folder in natural name order (2.pcd before 10.pcd).
 /// Throws InputError if the folder does not exist or holds no PCD file.
 std::vector<std::string> listPcdFiles(const std::string& folder);
