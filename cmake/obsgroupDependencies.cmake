@@ -45,6 +45,51 @@ macro(obsgroup_find_io_dependencies)
   find_package(PNG REQUIRED)
   find_package(PkgConfig REQUIRED)
   pkg_check_modules(LIBDEFLATE QUIET IMPORTED_TARGET libdeflate)
+  obsgroup_find_bag_dependencies()
+endmacro()
+
+# ROS bags, each optional (a reader built without one says so when asked):
+# ROS 1 through rosbag's storage library and the message headers Debian ships
+# (librosbag-storage-dev, libsensor-msgs-dev, libtf2-msgs-dev, libnav-msgs-dev,
+# libgeometry-msgs-dev); ROS 2's sqlite3 storage through SQLite and Fast CDR.
+# rosbag_storage's own CMake config drags in ament and Python, so its library
+# and the headers its bag.h includes (pluginlib, class_loader, rcpputils,
+# rcutils) are found directly.
+macro(obsgroup_find_bag_dependencies)
+  find_library(OBSGROUP_ROSBAG_STORAGE_LIBRARY NAMES rosbag_storage)
+  find_library(OBSGROUP_ROSCPP_SERIALIZATION_LIBRARY NAMES roscpp_serialization)
+  find_library(OBSGROUP_ROSTIME_LIBRARY NAMES rostime)
+  find_library(OBSGROUP_CPP_COMMON_LIBRARY NAMES cpp_common)
+  find_library(OBSGROUP_CONSOLE_BRIDGE_LIBRARY NAMES console_bridge)
+  find_path(OBSGROUP_ROSBAG_INCLUDE_DIR rosbag/bag.h)
+  find_path(OBSGROUP_SENSOR_MSGS_INCLUDE_DIR sensor_msgs/LaserScan.h)
+  find_path(OBSGROUP_TF2_MSGS_INCLUDE_DIR tf2_msgs/TFMessage.h)
+  find_path(OBSGROUP_NAV_MSGS_INCLUDE_DIR nav_msgs/Odometry.h)
+  find_path(OBSGROUP_PLUGINLIB_INCLUDE_DIR pluginlib/class_loader.hpp PATH_SUFFIXES pluginlib)
+  find_path(OBSGROUP_CLASS_LOADER_INCLUDE_DIR class_loader/class_loader.hpp PATH_SUFFIXES class_loader)
+  find_path(OBSGROUP_RCPPUTILS_INCLUDE_DIR rcpputils/shared_library.hpp PATH_SUFFIXES rcpputils)
+  find_path(OBSGROUP_RCUTILS_INCLUDE_DIR rcutils/types.h PATH_SUFFIXES rcutils)
+  find_path(OBSGROUP_AMENT_INDEX_INCLUDE_DIR ament_index_cpp/get_resource.hpp PATH_SUFFIXES ament_index_cpp)
+  set(OBSGROUP_ROS1_FOUND FALSE)
+  if(OBSGROUP_ROSBAG_STORAGE_LIBRARY AND OBSGROUP_ROSCPP_SERIALIZATION_LIBRARY AND OBSGROUP_ROSTIME_LIBRARY
+     AND OBSGROUP_CPP_COMMON_LIBRARY AND OBSGROUP_CONSOLE_BRIDGE_LIBRARY AND OBSGROUP_ROSBAG_INCLUDE_DIR AND OBSGROUP_SENSOR_MSGS_INCLUDE_DIR
+     AND OBSGROUP_TF2_MSGS_INCLUDE_DIR AND OBSGROUP_NAV_MSGS_INCLUDE_DIR AND OBSGROUP_PLUGINLIB_INCLUDE_DIR
+     AND OBSGROUP_CLASS_LOADER_INCLUDE_DIR AND OBSGROUP_RCPPUTILS_INCLUDE_DIR AND OBSGROUP_RCUTILS_INCLUDE_DIR
+     AND OBSGROUP_AMENT_INDEX_INCLUDE_DIR)
+    set(OBSGROUP_ROS1_FOUND TRUE)
+    if(NOT TARGET obsgroup::rosbag_storage)
+      add_library(obsgroup::rosbag_storage INTERFACE IMPORTED)
+      set_target_properties(obsgroup::rosbag_storage PROPERTIES
+        INTERFACE_INCLUDE_DIRECTORIES "${OBSGROUP_PLUGINLIB_INCLUDE_DIR};${OBSGROUP_CLASS_LOADER_INCLUDE_DIR};${OBSGROUP_RCPPUTILS_INCLUDE_DIR};${OBSGROUP_RCUTILS_INCLUDE_DIR};${OBSGROUP_AMENT_INDEX_INCLUDE_DIR}"
+        INTERFACE_LINK_LIBRARIES "${OBSGROUP_ROSBAG_STORAGE_LIBRARY};${OBSGROUP_ROSCPP_SERIALIZATION_LIBRARY};${OBSGROUP_ROSTIME_LIBRARY};${OBSGROUP_CPP_COMMON_LIBRARY};${OBSGROUP_CONSOLE_BRIDGE_LIBRARY}")
+    endif()
+  endif()
+  find_package(SQLite3 QUIET)
+  find_package(fastcdr CONFIG QUIET)
+  set(OBSGROUP_ROS2_FOUND FALSE)
+  if(SQLite3_FOUND AND fastcdr_FOUND)
+    set(OBSGROUP_ROS2_FOUND TRUE)
+  endif()
 endmacro()
 
 # obsgroup::obsgroup (the PCL templates, local maps): the core's and PCL's.

@@ -13,10 +13,27 @@
 // depth/*.png at 5000 per metre, groundtruth.txt of the optical frame: z
 // forward, x right, y down) and prints the --intrinsics it needs. Not
 // shipped; a test reads it and expects the groups of office_3d/pcd.
+//
+//   make_datasets --ros1-bag FILE | --ros2-bag FOLDER
+// writes the office_2d run as a ROS bag (ROS 1 .bag, or ROS 2 sqlite3): its
+// scans as sensor_msgs/LaserScan on /scan in frame laser (no return: +inf,
+// REP 117), /tf map -> odom -> base_link at each scan's stamp and /tf_static
+// base_link -> laser. Not shipped; a test reads it and expects the groups of
+// office_2d/office.clf.
 
 #include "floor_plan.h"
 #include "png_writer.h"
 #include "to_cloud.h"
+
+#include "bag_messages.h"
+#ifdef OBSGROUP_HAVE_ROS1
+#include <rosbag/bag.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_msgs/TFMessage.h>
+#endif
+#ifdef OBSGROUP_HAVE_ROS2
+#include "ros2_bag_writer.h"
+#endif
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -27,6 +44,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -140,12 +158,130 @@ int writeOffice3DTum(const fs::path& folder) {
   return 0;
 }
 
+namespace bag = obsgroup::io::bag;
+
+/// The office_2d run as bag messages: one scan and its /tf per stamp. The
+/// ranges are those of office.clf (millimetres), so both give the same points.
+struct BagRun {
+  std::vector<bag::Scan> scans;
+  std::vector<std::vector<bag::Transform>> tf;  // per scan: map -> odom, odom -> base_link
+  bag::Transform mount;                         // base_link -> laser
+};
+
+bag::Transform transform(const std::string& parent, const std::string& child, double stamp,
+                         const Eigen::Isometry3d& pose) {
+  bag::Transform t;
+  t.header = {stamp, parent};
+  t.child_frame_id = child;
+  t.transform = pose;
+  return t;
+}
+
+Eigen::Isometry3d planarPose(double x, double y, double yaw) {
+  return Eigen::Isometry3d(Eigen::Translation3d(x, y, 0) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+}
+
+BagRun office2DBagRun() {
+  const FloorPlan plan = office();
+  LaserModel laser;
+  laser.range_noise = 0.01;
+  const auto route = officeRoute(77);
+  BagRun run;
+  run.mount = transform("base_link", "laser", 1000.0, Eigen::Isometry3d::Identity());
+  // odom is offset from map, as after a SLAM correction; base_link's pose in map is the route's.
+  const Eigen::Isometry3d map_odom = planarPose(1.5, -2.0, 0.1);
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    const Pose2D& p = route[k];
+    const double stamp = 1000.0 + 0.5 * double(k);
+    bag::Scan scan;
+    scan.header = {stamp, "laser"};
+    scan.angle_min = -laser.field_of_view / 2;
+    scan.angle_increment = laser.field_of_view / (laser.beams - 1);
+    scan.range_min = 0.0;
+    scan.range_max = laser.max_range;
+    for (double r : plan.scan(p, laser, k)) {
+      const double mm = std::round(r * 1000.0) / 1000.0;  // as office.clf prints them
+      scan.ranges.push_back(mm >= laser.max_range ? std::numeric_limits<float>::infinity() : float(mm));
+    }
+    run.scans.push_back(std::move(scan));
+    run.tf.push_back({transform("map", "odom", stamp, map_odom),
+                      transform("odom", "base_link", stamp, map_odom.inverse() * planarPose(p.x, p.y, p.yaw))});
+  }
+  return run;
+}
+
+#ifdef OBSGROUP_HAVE_ROS1
+geometry_msgs::TransformStamped ros1Transform(const bag::Transform& t) {
+  geometry_msgs::TransformStamped m;
+  m.header.frame_id = t.header.frame_id;
+  m.header.stamp = ros::Time(t.header.stamp);
+  m.child_frame_id = t.child_frame_id;
+  const Eigen::Vector3d p = t.transform.translation();
+  const Eigen::Quaterniond q(t.transform.rotation());
+  m.transform.translation.x = p.x();
+  m.transform.translation.y = p.y();
+  m.transform.translation.z = p.z();
+  m.transform.rotation.x = q.x();
+  m.transform.rotation.y = q.y();
+  m.transform.rotation.z = q.z();
+  m.transform.rotation.w = q.w();
+  return m;
+}
+
+int writeOffice2DRos1(const std::string& path) {
+  const BagRun run = office2DBagRun();
+  rosbag::Bag out(path, rosbag::bagmode::Write);
+  tf2_msgs::TFMessage mount;
+  mount.transforms.push_back(ros1Transform(run.mount));
+  out.write("/tf_static", ros::Time(run.mount.header.stamp), mount);
+  for (std::size_t k = 0; k < run.scans.size(); ++k) {
+    const bag::Scan& s = run.scans[k];
+    tf2_msgs::TFMessage tf;
+    for (const auto& t : run.tf[k]) tf.transforms.push_back(ros1Transform(t));
+    out.write("/tf", ros::Time(s.header.stamp), tf);
+    sensor_msgs::LaserScan scan;
+    scan.header.frame_id = s.header.frame_id;
+    scan.header.stamp = ros::Time(s.header.stamp);
+    scan.angle_min = float(s.angle_min);
+    scan.angle_max = float(s.angle_min + s.angle_increment * double(s.ranges.size() - 1));
+    scan.angle_increment = float(s.angle_increment);
+    scan.range_min = float(s.range_min);
+    scan.range_max = float(s.range_max);
+    scan.ranges = s.ranges;
+    out.write("/scan", scan.header.stamp, scan);
+  }
+  std::printf("wrote %s\n", path.c_str());
+  return 0;
+}
+#endif
+
+#ifdef OBSGROUP_HAVE_ROS2
+int writeOffice2DRos2(const std::string& folder) {
+  const BagRun run = office2DBagRun();
+  obsgroup::test::Ros2BagWriter out(folder);
+  out.writeTf("/tf_static", {run.mount});
+  for (std::size_t k = 0; k < run.scans.size(); ++k) {
+    out.writeTf("/tf", run.tf[k]);
+    out.write("/scan", run.scans[k]);
+  }
+  out.close();
+  std::printf("wrote %s\n", folder.c_str());
+  return 0;
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--tum-rgbd") return writeOffice3DTum(argv[2]);
+#ifdef OBSGROUP_HAVE_ROS1
+  if (argc == 3 && std::string(argv[1]) == "--ros1-bag") return writeOffice2DRos1(argv[2]);
+#endif
+#ifdef OBSGROUP_HAVE_ROS2
+  if (argc == 3 && std::string(argv[1]) == "--ros2-bag") return writeOffice2DRos2(argv[2]);
+#endif
   if (argc < 2 || argc > 3 || (argc == 3 && std::string(argv[2]) != "--force")) {
-    std::cerr << "usage: " << argv[0] << " OUTDIR [--force] | --tum-rgbd FOLDER\n";
+    std::cerr << "usage: " << argv[0] << " OUTDIR [--force] | --tum-rgbd FOLDER | --ros1-bag FILE | --ros2-bag FOLDER\n";
     return 2;
   }
   const fs::path out = argv[1];

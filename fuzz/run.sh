@@ -15,11 +15,12 @@ jobs=$(nproc)
 
 CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOBSGROUP_BUILD_FUZZERS=ON \
   -DOBSGROUP_BUILD_TESTS=OFF -DOBSGROUP_BUILD_EXAMPLES=OFF > /dev/null
-cmake --build build-fuzz -j"$jobs" --target fuzz_carmen fuzz_pose_file fuzz_pcd fuzz_depth_png fuzz_sequence_text > /dev/null
+cmake --build build-fuzz -j"$jobs" --target fuzz_carmen fuzz_pose_file fuzz_pcd fuzz_depth_png fuzz_sequence_text \
+  fuzz_ros1_message fuzz_ros2_message > /dev/null
 
 mkdir -p build-fuzz/artifacts
 status=0
-for target in carmen pose_file pcd depth_png sequence_text; do
+for target in carmen pose_file pcd depth_png sequence_text ros1_message ros2_message; do
   work=build-fuzz/corpus/$target
   mkdir -p "$work"
   log=build-fuzz/fuzz_$target.log

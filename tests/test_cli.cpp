@@ -1016,6 +1016,69 @@ TEST_F(Cli, APoseFormatWithoutAPosesFileIsRefused) {
 }
 
 // ---------------------------------------------------------------------------
+// ROS bags: the office_2d run written as a ROS 1 and a ROS 2 bag.
+
+#if defined(OBSGROUP_HAVE_ROS1) && defined(OBSGROUP_HAVE_ROS2)
+TEST_F(Cli, SimulatedRosBagsGroupAsTheSameCarmenLog) {
+  const fs::path ros1 = dir_ / "office.bag", ros2 = dir_ / "office_ros2";
+  ASSERT_EQ(std::system((std::string(MAKE_DATASETS_EXE) + " --ros1-bag " + ros1.string() + " > /dev/null").c_str()), 0);
+  ASSERT_EQ(std::system((std::string(MAKE_DATASETS_EXE) + " --ros2-bag " + ros2.string() + " > /dev/null").c_str()), 0);
+  ASSERT_EQ(run("partition " + kData + "/office_2d/office.clf -q --no-pictures -o " + (dir_ / "log").string()).code, 0);
+  const nlohmann::json log = readJson(dir_ / "log" / "partition.json");
+  for (const auto& [bag, format] : {std::pair{ros1, "ros1"}, std::pair{ros2, "ros2"}}) {
+    const fs::path out = dir_ / (std::string("out_") + format);
+    const Result r = run("partition " + bag.string() + " --no-pictures -o " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json p = expectPartitionSchema(out, 77);
+    EXPECT_EQ(p.at("groups"), log.at("groups")) << format;
+    EXPECT_EQ(p.at("statistics").at("points"), log.at("statistics").at("points"));
+    const auto& parameters = p.at("parameters");
+    EXPECT_EQ(parameters.at("format"), format);
+    EXPECT_EQ(parameters.at("topic"), "/scan");
+    EXPECT_EQ(parameters.at("message_type"), "sensor_msgs/LaserScan");
+    EXPECT_EQ(parameters.at("poses_from"), "/tf");
+    EXPECT_EQ(parameters.at("fixed_frame"), "map");
+    EXPECT_EQ(parameters.at("skipped_messages"), 0);
+    // The poses in odom, rotated 0.1 rad from map: the grid of the sensed
+    // regions lies otherwise on the rooms, so the groups may differ a little.
+    const Result odom = run("partition " + bag.string() + " -q --no-pictures --fixed-frame odom -o " +
+                            (out.string() + "_odom"));
+    ASSERT_EQ(odom.code, 0) << odom.err;
+    const nlohmann::json in_odom = expectPartitionSchema(out.string() + "_odom", 77);
+    EXPECT_EQ(in_odom.at("parameters").at("fixed_frame"), "odom");
+  }
+  // A topic the bag does not have names the ones it has.
+  const Result missing = run("partition " + ros2.string() + " -q --topic /front_scan -o " + (dir_ / "m").string());
+  EXPECT_EQ(missing.code, 3);
+  EXPECT_NE(missing.err.find("no topic /front_scan (--topic)"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("/scan (sensor_msgs/LaserScan, 77)"), std::string::npos) << missing.err;
+  const Result frame = run("partition " + ros1.string() + " -q --fixed-frame world -o " + (dir_ / "w").string());
+  EXPECT_EQ(frame.code, 3);
+  EXPECT_NE(frame.err.find("/tf has no frame 'world' (--fixed-frame)"), std::string::npos) << frame.err;
+  EXPECT_FALSE(fs::exists(dir_ / "m"));
+}
+#endif
+
+TEST_F(Cli, BagOptionsAndBadBags) {
+  const std::string out = " -o " + (dir_ / "o").string();
+  const Result topic = run("partition " + kData + "/office_2d/office.clf --topic /scan" + out);
+  EXPECT_EQ(topic.code, 2);
+  EXPECT_NE(topic.err.find("--topic, --pose-topic and --fixed-frame apply to ROS bags only"), std::string::npos)
+      << topic.err;
+  std::ofstream(dir_ / "fake.bag") << "FLASER 3 1 1 1 0 0 0 0 0 0 0 host 0\n";
+  const Result fake = run("partition " + (dir_ / "fake.bag").string() + out);
+  EXPECT_EQ(fake.code, 3);
+  EXPECT_NE(fake.err.find("not a ROS 1 bag"), std::string::npos) << fake.err;
+  std::ofstream(dir_ / "cut.bag") << "#ROSBAG V2.0\n\x04\x00";
+  const Result cut = run("partition " + (dir_ / "cut.bag").string() + out);
+  EXPECT_EQ(cut.code, 3);
+  EXPECT_NE(cut.err.find("cut.bag"), std::string::npos) << cut.err;
+  const Result both = run("partition " + (dir_ / "cut.bag").string() + " --pose-topic /odom --fixed-frame map" + out);
+  EXPECT_EQ(both.code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+// ---------------------------------------------------------------------------
 // Depth image sequences, KITTI odometry and TUM poses matched by timestamp.
 
 TEST_F(Cli, SimulatedDepthImagesGroupAsTheSamePcdSequence) {

@@ -46,12 +46,26 @@ using cli::wholeNumber;
 void addInputOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("input", args.input,
                      "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input), folder of .pcd files, "
-                     "depth images (TUM RGB-D, Redwood) or KITTI odometry")
+                     "depth images (TUM RGB-D, Redwood), KITTI odometry, ROS 1 bag (.bag) or ROS 2 bag (sqlite3 "
+                     "folder)")
       ->required();
   command.add_option("-o,--output", args.output, "folder to write the results to")->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
-      ->check(CLI::IsMember({"auto", "carmen", "pcd", "tum-rgbd", "redwood", "kitti"}))
-      ->option_text("auto|carmen|pcd|tum-rgbd|redwood|kitti");
+      ->check(CLI::IsMember({"auto", "carmen", "pcd", "tum-rgbd", "redwood", "kitti", "ros1", "ros2"}))
+      ->option_text("auto|carmen|pcd|tum-rgbd|redwood|kitti|ros1|ros2");
+}
+
+/// Options of ROS bags.
+void addBagOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  command.add_option("--topic", args.topic,
+                     "bags: the sensor_msgs/LaserScan or PointCloud2 topic (default: the only one)")
+      ->group("ROS bags");
+  command.add_option("--pose-topic", args.pose_topic,
+                     "bags: a nav_msgs/Odometry or geometry_msgs/PoseStamped topic giving the poses (default: /tf)")
+      ->group("ROS bags");
+  command.add_option("--fixed-frame", args.fixed_frame,
+                     "bags: the /tf frame the poses are taken in (default: map, else odom with a warning)")
+      ->group("ROS bags");
 }
 
 /// Options of CARMEN logs.
@@ -197,6 +211,7 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   addCarmenOptions(command, args);
   addPcdOptions(command, args);
   addDepthOptions(command, args);
+  addBagOptions(command, args);
   addMethodOptions(command, args);
   addRunOptions(command, args);
 }

@@ -4,6 +4,7 @@
 #include <obsgroup/io/errors.h>
 #include <obsgroup/io/input_file.h>
 #include <obsgroup/io/kitti_sequence.h>
+#include <obsgroup/io/ros_bag.h>
 #include "local_maps.h"
 #include "output_folder.h"
 #include <obsgroup/io/pcd_sequence.h>
@@ -54,15 +55,20 @@ std::string detectFormat(const PartitionArgs& args) {
   if (args.format == "pcd" && !folder)
     throw io::UsageError(args.input + ": --format pcd needs a folder of .pcd files");
   if (args.format == "carmen" && folder) throw io::UsageError(args.input + ": --format carmen needs a log file");
-  if (args.format != "auto" && args.format != "carmen" && !folder)
+  if (args.format == "ros1" && folder) throw io::UsageError(args.input + ": --format ros1 needs a .bag file");
+  if (args.format != "auto" && args.format != "carmen" && args.format != "ros1" && !folder)
     throw io::UsageError(args.input + ": --format " + args.format + " needs a folder");
   if (args.format != "auto") return args.format;
+  if (const auto bag = io::detectBag(args.input)) return io::toString(*bag);
   if (folder) {
     if (const auto layout = io::detectDepthLayout(args.input)) return io::toString(*layout);
     if (io::isKittiFolder(args.input) || (args.poses && fs::is_directory(fs::path(args.input) / "velodyne", ec)))
       return "kitti";
     return "pcd";
   }
+  if (fs::path(args.input).extension() == ".bag")
+    throw io::InputError(args.input + ": not a ROS 1 bag (it does not start with \"#ROSBAG V2.0\"; ROS 1 bags of "
+                         "format 1.2 or older: migrate them with rosbag fix)");
   if (fs::path(args.input).extension() == ".pcd")
     throw io::UsageError(args.input + ": a single PCD file; give the folder holding the sequence");
   return "carmen";
@@ -80,6 +86,12 @@ void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format != "carmen" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
   if (format != "carmen" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
+  const bool bag = format == "ros1" || format == "ros2";
+  if (!bag && (args.topic || args.pose_topic || args.fixed_frame))
+    throw io::UsageError("--topic, --pose-topic and --fixed-frame apply to ROS bags only");
+  if (bag && args.poses) throw io::UsageError("--poses: a bag's poses come from /tf or --pose-topic");
+  if (args.pose_topic && args.fixed_frame)
+    throw io::UsageError("--fixed-frame applies to poses from /tf; a --pose-topic gives its own frame");
 }
 
 /// Warnings go to stderr as they happen and into partition.json.
@@ -453,6 +465,32 @@ int runKitti(const PartitionArgs& args) {
   return runPipeline(args, std::move(sequence.observations), std::move(input));
 }
 
+int runBag(const PartitionArgs& args, io::BagVersion version) {
+  const auto start = Clock::now();
+  if (!io::bagSupported(version))
+    throw io::InputError(args.input + ": this obsgroup was built without " +
+                         (version == io::BagVersion::Ros1 ? std::string("ROS 1 bag support (librosbag-storage-dev)")
+                                                          : std::string("ROS 2 bag support (libsqlite3-dev, "
+                                                                        "libfastcdr-dev)")));
+  io::BagOptions options;
+  options.topic = args.topic;
+  options.pose_topic = args.pose_topic;
+  options.fixed_frame = args.fixed_frame;
+  io::BagSequence sequence = io::loadBag(args.input, version, options);
+  InputRecord input;
+  input.format = io::toString(version);
+  input.labels = std::move(sequence.labels);
+  input.parameters = {{"topic", sequence.topic},
+                      {"message_type", sequence.message_type},
+                      {"poses_from", sequence.pose_source},
+                      {"fixed_frame", sequence.fixed_frame},
+                      {"skipped_messages", sequence.skipped},
+                      {"point_type", io::toString(io::PointKind::XYZ)}};
+  input.warnings = std::move(sequence.warnings);
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(sequence.observations), std::move(input));
+}
+
 }  // namespace
 
 int runPartition(const PartitionArgs& args) {
@@ -464,6 +502,8 @@ int runPartition(const PartitionArgs& args) {
   if (format == "tum-rgbd") return runDepth(args, io::DepthLayout::TumRgbd);
   if (format == "redwood") return runDepth(args, io::DepthLayout::Redwood);
   if (format == "kitti") return runKitti(args);
+  if (format == "ros1") return runBag(args, io::BagVersion::Ros1);
+  if (format == "ros2") return runBag(args, io::BagVersion::Ros2);
 
   const auto start = Clock::now();
   const auto files = io::listPcdFiles(args.input);

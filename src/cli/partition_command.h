@@ -18,7 +18,7 @@ namespace obsgroup::cli {
 struct PartitionArgs {
   std::string input;
   std::string output;
-  std::string format = "auto";  ///< auto, carmen, pcd, tum-rgbd, redwood or kitti
+  std::string format = "auto";  ///< auto, carmen, pcd, tum-rgbd, redwood, kitti, ros1 or ros2
   // CARMEN logs
   io::LaserSource laser = io::LaserSource::Auto;
   std::optional<double> field_of_view_deg;
@@ -33,6 +33,10 @@ struct PartitionArgs {
   std::optional<double> depth_scale;      ///< units per metre; default from the layout
   std::optional<double> depth_max;        ///< metres
   std::optional<int> stride;              ///< every Nth pixel in u and v
+  // ROS bags
+  std::optional<std::string> topic;        ///< LaserScan or PointCloud2 topic
+  std::optional<std::string> pose_topic;   ///< Odometry or PoseStamped topic
+  std::optional<std::string> fixed_frame;  ///< /tf frame of the poses
   // the method
   /// The defaults are the settings that measured best across lasers and
   /// depth cameras with drifted poses (docs/grouping.md); `--paper` gives the

@@ -1,0 +1,60 @@
+#pragma once
+// ROS bags as observations: sensor_msgs/LaserScan or sensor_msgs/PointCloud2
+// messages of one topic, each posed at its header stamp from /tf (the
+// sensor's frame in a fixed frame) or from a nav_msgs/Odometry or
+// geometry_msgs/PoseStamped topic with the sensor's mounting from
+// /tf_static. ROS 1 bags (.bag) are read with rosbag's storage library; ROS 2
+// bags in the default sqlite3 storage (a folder with metadata.yaml and
+// *.db3) with SQLite and Fast CDR. Neither needs a ROS installation.
+
+#include <obsgroup/cloud/observation.h>
+#include <obsgroup/common/enum_names.h>
+
+#include <pcl/point_types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace obsgroup::io {
+
+enum class BagVersion { Ros1, Ros2 };
+
+inline constexpr EnumName<BagVersion> kBagVersionNames[] = {{BagVersion::Ros1, "ros1"}, {BagVersion::Ros2, "ros2"}};
+inline std::string toString(BagVersion version) { return nameOf(kBagVersionNames, version); }
+
+/// Whether this build reads bags of `version` (its libraries were found).
+bool bagSupported(BagVersion version);
+
+struct BagOptions {
+  /// The LaserScan or PointCloud2 topic; default: the only topic of either type.
+  std::optional<std::string> topic;
+  /// An Odometry or PoseStamped topic giving the poses; default: /tf.
+  std::optional<std::string> pose_topic;
+  /// The frame /tf poses are taken in; default: map, else odom (with a warning).
+  std::optional<std::string> fixed_frame;
+};
+
+struct BagSequence {
+  BagVersion version = BagVersion::Ros1;
+  std::vector<Observation<pcl::PointXYZ>> observations;  ///< points in the sensor frame, posed in the fixed frame
+  std::vector<std::string> labels;  ///< "BAG: message N on TOPIC" of each observation
+  std::vector<std::string> warnings;
+  std::string topic;         ///< the data topic read
+  std::string message_type;  ///< sensor_msgs/LaserScan or sensor_msgs/PointCloud2
+  std::string pose_source;   ///< "/tf" or the pose topic
+  std::string fixed_frame;   ///< the frame of the poses
+  std::size_t skipped = 0;   ///< messages with no pose at their stamp (outside the poses' time span)
+};
+
+/// ROS 1 when `path` is a file starting with "#ROSBAG V2.0", ROS 2 when it
+/// is a folder holding metadata.yaml; else nothing.
+std::optional<BagVersion> detectBag(const std::string& path);
+
+/// Reads the bag. Throws InputError naming the bag, the topic and the message
+/// number (and the field) of anything that cannot be read, a topic that is
+/// missing or ambiguous (the topics present are listed), a fixed frame or
+/// mounting that /tf does not hold, or no message with a pose.
+BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options = {});
+
+}  // namespace obsgroup::io

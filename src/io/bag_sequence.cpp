@@ -1,0 +1,438 @@
+// ROS bags as observations: the topic chosen, each message posed at its
+// stamp by /tf or a pose topic, its points in the sensor frame.
+#include <obsgroup/io/ros_bag.h>
+
+#include "bag_messages.h"
+
+#include <obsgroup/io/errors.h>
+
+#include <pcl/PCLPointField.h>
+#include <pcl/common/io.h>
+#include <pcl/conversions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <type_traits>
+
+namespace obsgroup::io {
+
+namespace bag {
+
+void checkRole(const std::string& type, Role role, const std::string& context) {
+  const bool fits = role == Role::Data   ? type == kLaserScanType || type == kPointCloud2Type
+                    : role == Role::Pose ? type == kOdometryType || type == kPoseStampedType
+                                         : type == kTfType;
+  if (fits) return;
+  const char* wanted = role == Role::Data   ? "sensor_msgs/LaserScan or sensor_msgs/PointCloud2"
+                       : role == Role::Pose ? "nav_msgs/Odometry or geometry_msgs/PoseStamped"
+                                            : "tf2_msgs/TFMessage";
+  throw InputError(context + ": a " + type + " where a " + wanted + " is read");
+}
+
+void checkStamp(const Header& header, const std::string& context) {
+  if (!std::isfinite(header.stamp) || header.stamp < 0)
+    throw InputError(context + ": field header.stamp: not a time");
+}
+
+Eigen::Isometry3d checkedRigid(const Eigen::Vector3d& translation, const Eigen::Quaterniond& rotation,
+                               const std::string& context, const char* translation_field,
+                               const char* rotation_field) {
+  if (!translation.allFinite()) throw InputError(context + ": field " + translation_field + ": not finite");
+  const double norm = rotation.coeffs().norm();
+  if (!std::isfinite(norm) || norm < 1e-6)
+    throw InputError(context + ": field " + rotation_field + ": not a rotation (norm " + std::to_string(norm) + ")");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = rotation.normalized().toRotationMatrix();
+  pose.translation() = translation;
+  return pose;
+}
+
+void checkCloudLayout(const pcl::PCLPointCloud2& cloud, const std::string& context) {
+  auto fail = [&](const char* field, const std::string& what) {
+    throw InputError(context + ": field " + field + ": " + what);
+  };
+  if (cloud.is_bigendian) fail("is_bigendian", "big-endian point data is not supported");
+  const std::uint64_t row = std::uint64_t(cloud.width) * cloud.point_step;
+  if (row > cloud.row_step)
+    fail("row_step", std::to_string(cloud.row_step) + " is less than width * point_step = " + std::to_string(row));
+  const std::uint64_t bytes = std::uint64_t(cloud.row_step) * cloud.height;
+  if (bytes != cloud.data.size())
+    fail("data", std::to_string(cloud.data.size()) + " bytes where row_step * height = " + std::to_string(bytes));
+  for (const pcl::PCLPointField& field : cloud.fields) {
+    const int size = pcl::getFieldSize(field.datatype);
+    if (size == 0) fail("fields.datatype", "'" + field.name + "' has unknown datatype " + std::to_string(field.datatype));
+    if (std::uint64_t(field.offset) + std::uint64_t(size) * std::max<std::uint32_t>(field.count, 1) > cloud.point_step)
+      fail("fields.offset", "'" + field.name + "' ends beyond point_step " + std::to_string(cloud.point_step));
+  }
+}
+
+}  // namespace bag
+
+namespace {
+
+using bag::Numbered;
+
+/// A pose that changes with time: samples in time order, interpolated
+/// (translation linearly, rotation by slerp), never extrapolated.
+class PoseTrack {
+ public:
+  void add(double stamp, const Eigen::Isometry3d& pose) { samples_.push_back({stamp, pose}); }
+  void sort() {
+    std::stable_sort(samples_.begin(), samples_.end(), [](const Sample& a, const Sample& b) { return a.stamp < b.stamp; });
+  }
+  std::optional<Eigen::Isometry3d> at(double stamp) const {
+    if (samples_.empty() || stamp < samples_.front().stamp || stamp > samples_.back().stamp) return std::nullopt;
+    const auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp,
+                                        [](const Sample& s, double t) { return s.stamp < t; });
+    if (after->stamp == stamp || after == samples_.begin()) return after->pose;
+    const Sample& before = *std::prev(after);
+    const double f = (stamp - before.stamp) / (after->stamp - before.stamp);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = (1 - f) * before.pose.translation() + f * after->pose.translation();
+    pose.linear() = Eigen::Quaterniond(before.pose.rotation())
+                        .slerp(f, Eigen::Quaterniond(after->pose.rotation()))
+                        .toRotationMatrix();
+    return pose;
+  }
+
+ private:
+  struct Sample {
+    double stamp;
+    Eigen::Isometry3d pose;
+  };
+  std::vector<Sample> samples_;
+};
+
+/// The frames of /tf and /tf_static: each child has one parent, by a fixed
+/// transform (/tf_static) or one that changes with time (/tf).
+class FrameTree {
+ public:
+  FrameTree(const bag::Messages& messages, const std::string& bag_name) {
+    for (const auto& t : messages.tf_static) add(t, true, bag_name + ": message " + std::to_string(t.number) + " on /tf_static");
+    for (const auto& t : messages.tf) add(t, false, bag_name + ": message " + std::to_string(t.number) + " on /tf");
+    for (auto& [child, edge] : edges_) edge.track.sort();
+  }
+
+  bool has(const std::string& frame) const { return frames_.count(frame) > 0; }
+  bool hasParent(const std::string& frame) const { return edges_.count(frame) > 0; }
+  /// The topmost ancestor of `frame` through /tf_static edges only.
+  std::string staticRoot(std::string frame) const {
+    for (auto e = edges_.find(frame); e != edges_.end() && e->second.fixed; e = edges_.find(frame))
+      frame = e->second.parent;
+    return frame;
+  }
+
+  /// The pose of `source` in `target` at `stamp`, when both hang in one tree
+  /// and every moving edge between them has samples around the stamp.
+  std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source, double stamp) const {
+    if (target == source) return Eigen::Isometry3d::Identity();
+    const auto from_source = toRoot(source, stamp);
+    const auto from_target = toRoot(target, stamp);
+    if (!from_source || !from_target || from_source->root != from_target->root) return std::nullopt;
+    return from_target->pose.inverse() * from_source->pose;
+  }
+  /// Whether `source` and `target` hang in one tree at all.
+  bool connected(const std::string& target, const std::string& source) const {
+    return rootOf(target) == rootOf(source);
+  }
+
+ private:
+  struct Edge {
+    std::string parent;
+    bool fixed = false;
+    Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // fixed edges
+    PoseTrack track;                                              // moving edges
+  };
+  struct Chain {
+    std::string root;
+    Eigen::Isometry3d pose;  // of the frame in its root
+  };
+
+  void add(const Numbered<bag::Transform>& numbered, bool fixed, const std::string& context) {
+    const bag::Transform& t = numbered.message;
+    if (t.header.frame_id.empty() || t.child_frame_id.empty())
+      throw InputError(context + ": field " + (t.header.frame_id.empty() ? "header.frame_id" : "child_frame_id") +
+                       ": empty");
+    frames_.insert(t.header.frame_id);
+    frames_.insert(t.child_frame_id);
+    auto [it, fresh] = edges_.try_emplace(t.child_frame_id);
+    Edge& edge = it->second;
+    if (fresh) {
+      edge.parent = t.header.frame_id;
+      edge.fixed = fixed;
+    } else if (edge.parent != t.header.frame_id) {
+      throw InputError(context + ": frame '" + t.child_frame_id + "' has two parents, '" + edge.parent + "' and '" +
+                       t.header.frame_id + "'");
+    }
+    if (edge.fixed) {
+      edge.transform = t.transform;  // a later /tf_static message replaces an earlier one
+    } else {
+      edge.track.add(t.header.stamp, t.transform);
+    }
+  }
+
+  std::string rootOf(std::string frame) const {
+    for (std::size_t depth = 0; depth <= edges_.size(); ++depth) {
+      const auto e = edges_.find(frame);
+      if (e == edges_.end()) return frame;
+      frame = e->second.parent;
+    }
+    return {};  // a cycle: no root
+  }
+
+  std::optional<Chain> toRoot(std::string frame, double stamp) const {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    for (std::size_t depth = 0; depth <= edges_.size(); ++depth) {
+      const auto e = edges_.find(frame);
+      if (e == edges_.end()) return Chain{frame, pose};
+      const Edge& edge = e->second;
+      if (edge.fixed) {
+        pose = edge.transform * pose;
+      } else {
+        const auto moving = edge.track.at(stamp);
+        if (!moving) return std::nullopt;
+        pose = *moving * pose;
+      }
+      frame = edge.parent;
+    }
+    return std::nullopt;  // a cycle
+  }
+
+  std::map<std::string, Edge> edges_;  // by child frame
+  std::set<std::string> frames_;
+};
+
+std::string topicList(const std::vector<bag::Topic>& topics) {
+  if (topics.empty()) return "the bag has no topics";
+  std::string list = "topics:";
+  for (const auto& t : topics) list += " " + t.name + " (" + t.type + ", " + std::to_string(t.messages) + ")";
+  return list;
+}
+
+const bag::Topic* findTopic(const std::vector<bag::Topic>& topics, const std::string& name) {
+  for (const auto& t : topics)
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+const bag::Topic& chooseDataTopic(const std::vector<bag::Topic>& topics, const std::optional<std::string>& asked,
+                                  const std::string& bag_name) {
+  auto isData = [](const bag::Topic& t) { return t.type == bag::kLaserScanType || t.type == bag::kPointCloud2Type; };
+  if (asked) {
+    const bag::Topic* topic = findTopic(topics, *asked);
+    if (!topic) throw InputError(bag_name + ": no topic " + *asked + " (--topic); " + topicList(topics));
+    if (!isData(*topic))
+      throw InputError(bag_name + ": topic " + *asked + " is a " + topic->type +
+                       ", not a sensor_msgs/LaserScan or sensor_msgs/PointCloud2 (--topic)");
+    return *topic;
+  }
+  std::vector<const bag::Topic*> data;
+  for (const auto& t : topics)
+    if (isData(t)) data.push_back(&t);
+  if (data.empty())
+    throw InputError(bag_name + ": no sensor_msgs/LaserScan or sensor_msgs/PointCloud2 topic; " + topicList(topics));
+  if (data.size() > 1) {
+    std::string names;
+    for (const auto* t : data) names += " " + t->name;
+    throw InputError(bag_name + ": several scan or cloud topics (" + names.substr(1) + "): choose one with --topic");
+  }
+  return *data.front();
+}
+
+void checkPoseTopic(const std::vector<bag::Topic>& topics, const std::string& asked, const std::string& bag_name) {
+  const bag::Topic* topic = findTopic(topics, asked);
+  if (!topic) throw InputError(bag_name + ": no topic " + asked + " (--pose-topic); " + topicList(topics));
+  if (topic->type != bag::kOdometryType && topic->type != bag::kPoseStampedType)
+    throw InputError(bag_name + ": topic " + asked + " is a " + topic->type +
+                     ", not a nav_msgs/Odometry or geometry_msgs/PoseStamped (--pose-topic)");
+}
+
+/// A scan's returns as points in its frame (x ahead, y left): finite ranges
+/// within [range_min, range_max].
+pcl::PointCloud<pcl::PointXYZ>::Ptr scanPoints(const bag::Scan& scan) {
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->reserve(scan.ranges.size());
+  for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
+    const double r = scan.ranges[k];
+    if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max || r <= 0) continue;
+    const double angle = scan.angle_min + double(k) * scan.angle_increment;
+    cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
+  }
+  return cloud;
+}
+
+/// The finite x, y, z of a PointCloud2, which must have them as FLOAT32.
+pcl::PointCloud<pcl::PointXYZ>::Ptr cloudPoints(const bag::Cloud& message, const std::string& context) {
+  for (const char* axis : {"x", "y", "z"}) {
+    const auto field = std::find_if(message.cloud.fields.begin(), message.cloud.fields.end(),
+                                    [&](const pcl::PCLPointField& f) { return f.name == axis; });
+    if (field == message.cloud.fields.end())
+      throw InputError(context + ": field fields: no '" + axis + "' field (x, y, z are read)");
+    if (field->datatype != pcl::PCLPointField::FLOAT32)
+      throw InputError(context + ": field fields: '" + axis + "' is not FLOAT32 (datatype " +
+                       std::to_string(field->datatype) + ")");
+  }
+  pcl::PointCloud<pcl::PointXYZ> all;
+  pcl::fromPCLPointCloud2(message.cloud, all);
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->reserve(all.size());
+  for (const auto& p : all)
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud->push_back(p);
+  return cloud;
+}
+
+/// Where the poses come from: /tf in a fixed frame, or a pose topic and the
+/// sensor's mounting on the body it gives.
+class PoseSource {
+ public:
+  PoseSource(const bag::Messages& messages, const BagOptions& options, const std::string& bag_name,
+             std::vector<std::string>& warnings)
+      : tree_(messages, bag_name), bag_name_(bag_name), warnings_(warnings) {
+    if (options.pose_topic) {
+      for (const auto& p : messages.poses) {
+        track_.add(p.message.header.stamp, p.message.pose);
+        body_ = p.message.child_frame_id;
+        fixed_frame_ = p.message.header.frame_id;
+      }
+      track_.sort();
+      if (messages.poses.empty()) throw InputError(bag_name + ": no message on " + *options.pose_topic);
+      description_ = *options.pose_topic;
+      return;
+    }
+    description_ = "/tf";
+    fixed_frame_ = options.fixed_frame.value_or("map");
+    if (tree_.has(fixed_frame_)) return;
+    if (options.fixed_frame || !tree_.has("odom"))
+      throw InputError(bag_name + ": /tf has no frame '" + fixed_frame_ + "'" +
+                       (options.fixed_frame ? std::string(" (--fixed-frame)") : " nor 'odom'") +
+                       "; give the frame the poses are in with --fixed-frame, or a pose topic with --pose-topic");
+    warnings_.push_back(bag_name + ": /tf has no 'map' frame: the poses are taken in 'odom' (odometry, which drifts)");
+    fixed_frame_ = "odom";
+  }
+
+  const std::string& description() const { return description_; }
+  const std::string& fixedFrame() const { return fixed_frame_; }
+
+  /// The sensor's pose at the stamp, or nothing when the poses do not span it.
+  std::optional<Eigen::Isometry3d> at(const std::string& sensor, double stamp, const std::string& context) {
+    if (description_ == "/tf") {
+      if (!tree_.connected(fixed_frame_, sensor))
+        throw InputError(context + ": /tf does not connect the sensor's frame '" + sensor + "' to '" + fixed_frame_ + "'");
+      return tree_.lookup(fixed_frame_, sensor, stamp);
+    }
+    const auto body = track_.at(stamp);
+    if (!body) return std::nullopt;
+    const auto mount = mounting(sensor, stamp);
+    if (!mount) return std::nullopt;
+    return *body * *mount;
+  }
+
+ private:
+  /// The sensor's pose on the body the pose topic moves: /tf from the
+  /// Odometry's child frame; for PoseStamped (no child frame) the root of the
+  /// sensor's /tf_static chain. No such transform: the sensor is the body.
+  std::optional<Eigen::Isometry3d> mounting(const std::string& sensor, double stamp) {
+    const std::string body = body_.empty() ? tree_.staticRoot(sensor) : body_;
+    if (body == sensor) return Eigen::Isometry3d::Identity();
+    if (!tree_.connected(body, sensor)) {
+      if (!warned_unmounted_)
+        warnings_.push_back(bag_name_ + ": no /tf_static from '" + body + "' to the sensor's frame '" + sensor +
+                            "': the sensor is taken to be at the poses of " + description_);
+      warned_unmounted_ = true;
+      return Eigen::Isometry3d::Identity();
+    }
+    return tree_.lookup(body, sensor, stamp);
+  }
+
+  FrameTree tree_;
+  PoseTrack track_;
+  std::string body_;
+  std::string fixed_frame_;
+  std::string description_;
+  std::string bag_name_;
+  std::vector<std::string>& warnings_;
+  bool warned_unmounted_ = false;
+};
+
+template <typename Message>
+void addObservations(const std::vector<Numbered<Message>>& messages, const std::string& topic, PoseSource& poses,
+                     const std::string& bag_name, BagSequence& sequence) {
+  for (const auto& [number, message] : messages) {
+    const std::string label = bag_name + ": message " + std::to_string(number) + " on " + topic;
+    if (message.header.frame_id.empty()) throw InputError(label + ": field header.frame_id: empty");
+    const auto pose = poses.at(message.header.frame_id, message.header.stamp, label);
+    if (!pose) {
+      ++sequence.skipped;
+      continue;
+    }
+    if constexpr (std::is_same_v<Message, bag::Scan>) {
+      sequence.observations.push_back({scanPoints(message), *pose});
+    } else {
+      sequence.observations.push_back({cloudPoints(message, label), *pose});
+    }
+    sequence.labels.push_back(label);
+  }
+}
+
+}  // namespace
+
+bool bagSupported(BagVersion version) {
+#ifdef OBSGROUP_HAVE_ROS1
+  if (version == BagVersion::Ros1) return true;
+#endif
+#ifdef OBSGROUP_HAVE_ROS2
+  if (version == BagVersion::Ros2) return true;
+#endif
+  (void)version;
+  return false;
+}
+
+std::optional<BagVersion> detectBag(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    if (fs::exists(fs::path(path) / "metadata.yaml", ec)) return BagVersion::Ros2;
+    return std::nullopt;
+  }
+  std::ifstream in(path, std::ios::binary);
+  char magic[13] = {};
+  in.read(magic, 13);
+  if (in.gcount() == 13 && std::string(magic, 13) == "#ROSBAG V2.0\n") return BagVersion::Ros1;
+  return std::nullopt;
+}
+
+BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options) {
+  const bool ros1 = version == BagVersion::Ros1;
+  const std::vector<bag::Topic> topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
+  const bag::Topic& data = chooseDataTopic(topics, options.topic, path);
+  if (options.pose_topic) checkPoseTopic(topics, *options.pose_topic, path);
+  if (options.pose_topic && options.fixed_frame)
+    throw UsageError("--fixed-frame applies to poses from /tf; a pose topic gives its own frame");
+  bag::Request request{data.name, options.pose_topic};
+  const bag::Messages messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
+
+  BagSequence sequence;
+  sequence.version = version;
+  sequence.topic = data.name;
+  sequence.message_type = data.type;
+  PoseSource poses(messages, options, path, sequence.warnings);
+  sequence.pose_source = poses.description();
+  sequence.fixed_frame = poses.fixedFrame();
+  addObservations(messages.scans, data.name, poses, path, sequence);
+  addObservations(messages.clouds, data.name, poses, path, sequence);
+  const std::size_t total = messages.scans.size() + messages.clouds.size();
+  if (sequence.observations.empty())
+    throw InputError(path + ": none of the " + std::to_string(total) + " messages on " + data.name +
+                     " has a pose from " + poses.description() + " at its stamp");
+  if (sequence.skipped > 0)
+    sequence.warnings.push_back(std::to_string(sequence.skipped) + " of " + std::to_string(total) + " messages on " +
+                                data.name + " are outside the time span of " + poses.description() +
+                                " (no pose is extrapolated): skipped");
+  return sequence;
+}
+
+}  // namespace obsgroup::io

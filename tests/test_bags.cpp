@@ -1,0 +1,368 @@
+// ROS bags as observations, on small bags written by the tests with the same
+// libraries a robot's recorder uses: rosbag's storage library and the
+// message types of the ROS 1 headers; SQLite and Fast CDR for ROS 2.
+#include <obsgroup/io/errors.h>
+#include <obsgroup/io/ros_bag.h>
+
+#include "bag_messages.h"
+#include "temp_folder.h"
+
+#ifdef OBSGROUP_HAVE_ROS1
+#include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <rosbag/bag.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
+#endif
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <fstream>
+#include <limits>
+
+using namespace obsgroup::io;
+namespace fs = std::filesystem;
+
+namespace {
+
+::testing::AssertionResult throwsMentioning(const std::function<void()>& action, std::vector<std::string> parts) {
+  try {
+    action();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    for (const auto& part : parts)
+      if (message.find(part) == std::string::npos)
+        return ::testing::AssertionFailure() << "'" << message << "' does not mention '" << part << "'";
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "no InputError";
+}
+
+Eigen::Isometry3d planar(double x, double y, double yaw) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(x, y, 0);
+  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return pose;
+}
+
+void expectPose(const Eigen::Isometry3d& actual, const Eigen::Isometry3d& expected, double tolerance = 1e-6) {
+  EXPECT_LT((actual.matrix() - expected.matrix()).cwiseAbs().maxCoeff(), tolerance)
+      << "actual\n" << actual.matrix() << "\nexpected\n" << expected.matrix();
+}
+
+class BagDetection : public obsgroup::test::TempFolderTest {};
+
+TEST_F(BagDetection, TellsRos1FilesAndRos2FoldersFromOthers) {
+  const fs::path dir = dir_;
+  fs::create_directories(dir / "ros2");
+  std::ofstream(dir / "ros2" / "metadata.yaml") << "rosbag2_bagfile_information:\n";
+  std::ofstream(dir / "a.bag", std::ios::binary) << "#ROSBAG V2.0\n....";
+  std::ofstream(dir / "b.bag", std::ios::binary) << "FLASER 3 1 1 1\n";
+  EXPECT_EQ(detectBag((dir / "ros2").string()), BagVersion::Ros2);
+  EXPECT_EQ(detectBag((dir / "a.bag").string()), BagVersion::Ros1);
+  EXPECT_EQ(detectBag((dir / "b.bag").string()), std::nullopt);
+  EXPECT_EQ(detectBag(dir.string()), std::nullopt);
+}
+
+#ifdef OBSGROUP_HAVE_ROS1
+
+ros::Time rosTime(double seconds) { return ros::Time(seconds); }
+
+geometry_msgs::TransformStamped transformMessage(const std::string& parent, const std::string& child, double stamp,
+                                                 const Eigen::Isometry3d& pose) {
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = parent;
+  t.header.stamp = rosTime(stamp);
+  t.child_frame_id = child;
+  t.transform.translation.x = pose.translation().x();
+  t.transform.translation.y = pose.translation().y();
+  t.transform.translation.z = pose.translation().z();
+  const Eigen::Quaterniond q(pose.rotation());
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
+  return t;
+}
+
+/// A scan of three beams at -90, 0 and +90 degrees: 1, 2 and 3 m.
+sensor_msgs::LaserScan scanMessage(const std::string& frame, double stamp) {
+  sensor_msgs::LaserScan scan;
+  scan.header.frame_id = frame;
+  scan.header.stamp = rosTime(stamp);
+  scan.angle_min = float(-M_PI / 2);
+  scan.angle_max = float(M_PI / 2);
+  scan.angle_increment = float(M_PI / 2);
+  scan.range_min = 0.1f;
+  scan.range_max = 10.0f;
+  scan.ranges = {1.0f, 2.0f, 3.0f};
+  return scan;
+}
+
+/// The laser 0.2 m ahead of base_link; base_link moves in odom from (0,0)
+/// at t=10 to (2,0) facing left at t=12; odom sits at (100, 0) in map.
+class Ros1Bag : public obsgroup::test::TempFolderTest {
+ protected:
+  std::string path() const { return (dir_ / "run.bag").string(); }
+
+  void writeRun(bool with_map = true, bool with_mount = true) {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    if (with_mount) {
+      tf2_msgs::TFMessage mount;
+      mount.transforms.push_back(transformMessage("base_link", "laser", 0, planar(0.2, 0, 0)));
+      bag.write("/tf_static", rosTime(10), mount);
+    }
+    for (int k = 0; k <= 2; ++k) {
+      const double t = 10 + k;
+      tf2_msgs::TFMessage tf;
+      tf.transforms.push_back(transformMessage("odom", "base_link", t, planar(k, 0, k * M_PI / 4)));
+      if (with_map) tf.transforms.push_back(transformMessage("map", "odom", t, planar(100, 0, 0)));
+      bag.write("/tf", rosTime(t), tf);
+    }
+    for (double t : {10.0, 11.5, 12.0, 13.0}) bag.write("/scan", rosTime(t), scanMessage("laser", t));
+  }
+};
+
+TEST_F(Ros1Bag, ScansArePosedByTfInterpolatedAtTheirStamps) {
+  writeRun();
+  const BagSequence read = loadBag(path(), BagVersion::Ros1);
+  EXPECT_EQ(read.topic, "/scan");
+  EXPECT_EQ(read.message_type, "sensor_msgs/LaserScan");
+  EXPECT_EQ(read.pose_source, "/tf");
+  EXPECT_EQ(read.fixed_frame, "map");
+  // The scan at t=13 is after the last /tf: skipped, never extrapolated.
+  ASSERT_EQ(read.observations.size(), 3u);
+  EXPECT_EQ(read.skipped, 1u);
+  ASSERT_EQ(read.warnings.size(), 1u);
+  EXPECT_NE(read.warnings[0].find("1 of 4 messages on /scan"), std::string::npos) << read.warnings[0];
+  const Eigen::Isometry3d mount = planar(0.2, 0, 0), map_odom = planar(100, 0, 0);
+  expectPose(read.observations[0].pose, map_odom * planar(0, 0, 0) * mount);
+  expectPose(read.observations[1].pose, map_odom * planar(1.5, 0, 1.5 * M_PI / 4) * mount);
+  expectPose(read.observations[2].pose, map_odom * planar(2, 0, M_PI / 2) * mount);
+  EXPECT_EQ(read.labels[1], path() + ": message 2 on /scan");
+  // Points in the laser frame: beam k at -90 + 90k degrees.
+  const auto& cloud = *read.observations[0].cloud;
+  ASSERT_EQ(cloud.size(), 3u);
+  EXPECT_NEAR(cloud[0].x, 0, 1e-6);
+  EXPECT_NEAR(cloud[0].y, -1, 1e-6);
+  EXPECT_NEAR(cloud[1].x, 2, 1e-6);
+  EXPECT_NEAR(cloud[2].y, 3, 1e-6);
+}
+
+TEST_F(Ros1Bag, WithoutAMapFrameThePosesAreInOdomWithAWarning) {
+  writeRun(/*with_map=*/false);
+  const BagSequence read = loadBag(path(), BagVersion::Ros1);
+  EXPECT_EQ(read.fixed_frame, "odom");
+  ASSERT_EQ(read.observations.size(), 3u);
+  expectPose(read.observations[0].pose, planar(0.2, 0, 0));
+  ASSERT_FALSE(read.warnings.empty());
+  EXPECT_NE(read.warnings[0].find("'odom'"), std::string::npos);
+  BagOptions options;
+  options.fixed_frame = "world";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); }, {"no frame 'world'", "--fixed-frame"}));
+}
+
+TEST_F(Ros1Bag, APoseTopicMovesTheBodyAndTfStaticMountsTheSensor) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage mount;
+    mount.transforms.push_back(transformMessage("base_link", "laser", 0, planar(0.2, 0.1, M_PI)));
+    bag.write("/tf_static", rosTime(1), mount);
+    for (int k = 0; k < 3; ++k) {
+      nav_msgs::Odometry odom;
+      odom.header.frame_id = "odom";
+      odom.header.stamp = rosTime(1 + k);
+      odom.child_frame_id = "base_link";
+      odom.pose.pose.position.x = k;
+      odom.pose.pose.orientation.w = 1;
+      bag.write("/odom", rosTime(1 + k), odom);
+      geometry_msgs::PoseStamped slam;
+      slam.header = odom.header;
+      slam.header.frame_id = "map";
+      slam.pose.position.y = 5 + k;
+      slam.pose.orientation.w = 1;
+      bag.write("/slam_pose", rosTime(1 + k), slam);
+    }
+    bag.write("/scan", rosTime(1.5), scanMessage("laser", 1.5));
+  }
+  BagOptions options;
+  options.pose_topic = "/odom";
+  const BagSequence odom = loadBag(path(), BagVersion::Ros1, options);
+  EXPECT_EQ(odom.pose_source, "/odom");
+  EXPECT_EQ(odom.fixed_frame, "odom");
+  ASSERT_EQ(odom.observations.size(), 1u);
+  expectPose(odom.observations[0].pose, planar(0.5, 0, 0) * planar(0.2, 0.1, M_PI));
+  // PoseStamped carries no child frame: the pose is that of the root of the
+  // sensor's /tf_static chain (base_link).
+  options.pose_topic = "/slam_pose";
+  const BagSequence slam = loadBag(path(), BagVersion::Ros1, options);
+  EXPECT_EQ(slam.fixed_frame, "map");
+  expectPose(slam.observations[0].pose, planar(0, 5.5, 0) * planar(0.2, 0.1, M_PI));
+  options.pose_topic = "/scan";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"/scan is a sensor_msgs/LaserScan", "--pose-topic"}));
+  options.pose_topic = "/gps";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"no topic /gps", "/odom (nav_msgs/Odometry, 3)"}));
+}
+
+TEST_F(Ros1Bag, SeveralScanTopicsNeedTopicAndAMissingOneListsThem) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "laser", 1, planar(0, 0, 0)));
+    tf.transforms.push_back(transformMessage("map", "rear", 1, planar(0, 0, M_PI)));
+    bag.write("/tf", rosTime(1), tf);
+    bag.write("/front_scan", rosTime(1), scanMessage("laser", 1));
+    bag.write("/rear_scan", rosTime(1), scanMessage("rear", 1));
+  }
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); },
+                               {"several scan or cloud topics", "/front_scan", "/rear_scan", "--topic"}));
+  BagOptions options;
+  options.topic = "/rear_scan";
+  const BagSequence rear = loadBag(path(), BagVersion::Ros1, options);
+  ASSERT_EQ(rear.observations.size(), 1u);
+  expectPose(rear.observations[0].pose, planar(0, 0, M_PI));
+  options.topic = "/scan";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"no topic /scan", "/front_scan (sensor_msgs/LaserScan, 1)", "/tf (tf2_msgs/TFMessage, 1)"}));
+}
+
+TEST_F(Ros1Bag, PointCloudsKeepTheirFiniteXyzAcrossPaddedRows) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "camera", 5, planar(1, 2, 0)));
+    bag.write("/tf", rosTime(5), tf);
+    sensor_msgs::PointCloud2 cloud;
+    cloud.header.frame_id = "camera";
+    cloud.header.stamp = rosTime(5);
+    cloud.height = 2;
+    cloud.width = 2;
+    for (const char* axis : {"x", "y", "z", "intensity"}) {
+      sensor_msgs::PointField f;
+      f.name = axis;
+      f.offset = std::uint32_t(4 * cloud.fields.size());
+      f.datatype = sensor_msgs::PointField::FLOAT32;
+      f.count = 1;
+      cloud.fields.push_back(f);
+    }
+    cloud.point_step = 16;
+    cloud.row_step = 40;  // 8 bytes of padding per row
+    cloud.data.assign(cloud.row_step * cloud.height, 0);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float points[4][4] = {{1, 2, 3, 9}, {4, 5, 6, 9}, {nan, nan, nan, 9}, {7, 8, 9, 9}};
+    for (int k = 0; k < 4; ++k)
+      std::memcpy(&cloud.data[(k / 2) * cloud.row_step + (k % 2) * cloud.point_step], points[k], 16);
+    cloud.is_dense = false;
+    bag.write("/points", rosTime(5), cloud);
+  }
+  const BagSequence read = loadBag(path(), BagVersion::Ros1);
+  EXPECT_EQ(read.message_type, "sensor_msgs/PointCloud2");
+  ASSERT_EQ(read.observations.size(), 1u);
+  const auto& cloud = *read.observations[0].cloud;
+  ASSERT_EQ(cloud.size(), 3u);
+  EXPECT_EQ(cloud[1].x, 4);
+  EXPECT_EQ(cloud[2].z, 9);
+  expectPose(read.observations[0].pose, planar(1, 2, 0));
+}
+
+/// The serialised bytes of a ROS 1 message, as a bag holds them.
+template <typename Message>
+std::vector<unsigned char> serialised(const Message& message) {
+  std::vector<unsigned char> bytes(ros::serialization::serializationLength(message));
+  ros::serialization::OStream out(bytes.data(), std::uint32_t(bytes.size()));
+  ros::serialization::serialize(out, message);
+  return bytes;
+}
+
+TEST(Ros1Message, ACutMessageNamesItsField) {
+  sensor_msgs::LaserScan scan = scanMessage("laser", 3);
+  scan.ranges.assign(100, 1.5f);
+  const auto bytes = serialised(scan);
+  bag::Messages into;
+  bag::decodeRos1Message(bag::kLaserScanType, bag::Role::Data, bytes.data(), bytes.size(), "x.bag: message 7", 7, into);
+  ASSERT_EQ(into.scans.size(), 1u);
+  EXPECT_EQ(into.scans[0].number, 7u);
+  EXPECT_EQ(into.scans[0].message.ranges.size(), 100u);
+  EXPECT_DOUBLE_EQ(into.scans[0].message.header.stamp, 3.0);
+  EXPECT_TRUE(throwsMentioning(
+      [&] { bag::decodeRos1Message(bag::kLaserScanType, bag::Role::Data, bytes.data(), bytes.size() - 200, "x.bag: message 7", 7, into); },
+      {"x.bag: message 7", "field ranges"}));
+}
+
+TEST(Ros1Message, ALengthBeyondTheDataIsRefusedBeforeAllocating) {
+  sensor_msgs::LaserScan scan = scanMessage("laser", 3);
+  auto bytes = serialised(scan);
+  // The ranges' count sits 12 bytes before the end (3 floats) and 4 before
+  // the intensities' count: claim 4 billion ranges.
+  const std::size_t count_at = bytes.size() - 4 - 12 - 4;
+  const std::uint32_t huge = 0xFFFFFFF0u;
+  std::memcpy(&bytes[count_at], &huge, 4);
+  bag::Messages into;
+  EXPECT_TRUE(throwsMentioning(
+      [&] { bag::decodeRos1Message(bag::kLaserScanType, bag::Role::Data, bytes.data(), bytes.size(), "b", 1, into); },
+      {"field ranges", "elements claimed"}));
+}
+
+TEST(Ros1Message, ACloudWhoseDataDoNotFitItsRowsIsRefused) {
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = "c";
+  cloud.height = 1;
+  cloud.width = 10;
+  sensor_msgs::PointField f;
+  f.name = "x";
+  f.datatype = sensor_msgs::PointField::FLOAT32;
+  f.count = 1;
+  cloud.fields = {f};
+  cloud.point_step = 4;
+  cloud.row_step = 40;
+  cloud.data.assign(36, 0);
+  bag::Messages into;
+  auto bytes = serialised(cloud);
+  EXPECT_TRUE(throwsMentioning(
+      [&] { bag::decodeRos1Message(bag::kPointCloud2Type, bag::Role::Data, bytes.data(), bytes.size(), "c", 1, into); },
+      {"field data", "36 bytes where row_step * height = 40"}));
+  cloud.data.assign(40, 0);
+  cloud.is_bigendian = true;
+  bytes = serialised(cloud);
+  EXPECT_TRUE(throwsMentioning(
+      [&] { bag::decodeRos1Message(bag::kPointCloud2Type, bag::Role::Data, bytes.data(), bytes.size(), "c", 1, into); },
+      {"big-endian"}));
+}
+
+TEST(Ros1Message, AZeroQuaternionIsNotARotation) {
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(transformMessage("map", "laser", 1, planar(0, 0, 0)));
+  tf.transforms[0].transform.rotation.w = 0;
+  const auto bytes = serialised(tf);
+  bag::Messages into;
+  EXPECT_TRUE(throwsMentioning(
+      [&] { bag::decodeRos1Message(bag::kTfType, bag::Role::Tf, bytes.data(), bytes.size(), "t", 1, into); },
+      {"transforms.transform.rotation", "not a rotation"}));
+}
+
+TEST_F(Ros1Bag, AFileThatIsNotABagIsAnInputError) {
+  std::ofstream(path(), std::ios::binary) << "#ROSBAG V2.0\nthis is not a bag at all";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); }, {path(), "not a readable ROS 1 bag"}));
+}
+
+TEST_F(Ros1Bag, AScanInAFrameTfDoesNotConnectIsNamed) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "base_link", 1, planar(0, 0, 0)));
+    bag.write("/tf", rosTime(1), tf);
+    bag.write("/scan", rosTime(1), scanMessage("laser", 1));
+  }
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); },
+                               {"message 1 on /scan", "'laser'", "'map'"}));
+}
+
+#endif
+
+}  // namespace
