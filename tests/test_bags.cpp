@@ -59,6 +59,10 @@ class BagDetection : public obsgroup::test::TempFolderTest {};
 TEST_F(BagDetection, TellsRos1FilesAndRos2FoldersFromOthers) {
   const fs::path dir = dir_;
   fs::create_directories(dir / "ros2");
+  std::ofstream(dir / "ros2" / "bag_0.db3", std::ios::binary) << std::string("SQLite format 3\0", 16) << "...";
+  std::ofstream(dir / "run.mcap", std::ios::binary) << "\x89MCAP0\r\n....";
+  EXPECT_EQ(detectBag((dir / "ros2" / "bag_0.db3").string()), BagVersion::Ros2);
+  EXPECT_TRUE(throwsMentioning([&] { detectBag((dir / "run.mcap").string()); }, {"run.mcap", "MCAP storage is not supported", "`ros2 bag convert`"}));
   std::ofstream(dir / "ros2" / "metadata.yaml") << "rosbag2_bagfile_information:\n";
   std::ofstream(dir / "a.bag", std::ios::binary) << "#ROSBAG V2.0\n....";
   std::ofstream(dir / "b.bag", std::ios::binary) << "FLASER 3 1 1 1\n";
@@ -342,7 +346,7 @@ TEST(Ros1Message, ACloudWhoseDataDoNotFitItsRowsIsRefused) {
   auto bytes = serialised(cloud);
   EXPECT_TRUE(throwsMentioning(
       [&] { bag::decodeRos1Message(bag::kPointCloud2Type, bag::Role::Data, bytes.data(), bytes.size(), "c", 1, into); },
-      {"field data", "36 bytes where row_step * height = 40"}));
+      {"field data", "36 bytes, fewer than row_step x height = 40 x 1 = 40"}));
   cloud.data.assign(40, 0);
   cloud.is_bigendian = true;
   bytes = serialised(cloud);
@@ -359,7 +363,44 @@ TEST(Ros1Message, AZeroQuaternionIsNotARotation) {
   bag::Messages into;
   EXPECT_TRUE(throwsMentioning(
       [&] { bag::decodeRos1Message(bag::kTfType, bag::Role::Tf, bytes.data(), bytes.size(), "t", 1, into); },
-      {"transforms.transform.rotation", "not a rotation"}));
+      {"transforms.transform.rotation", "is no rotation"}));
+}
+
+TEST_F(Ros1Bag, ARangeAtRangeMaxIsNoReturn) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "laser", 1, planar(0, 0, 0)));
+    bag.write("/tf", rosTime(1), tf);
+    sensor_msgs::LaserScan scan = scanMessage("laser", 1);
+    scan.ranges = {1.0f, 10.0f, std::numeric_limits<float>::infinity(), 0.05f, 3.0f};  // range_min 0.1, range_max 10
+    bag.write("/scan", rosTime(1), scan);
+  }
+  const BagSequence read = loadBag(path(), BagVersion::Ros1);
+  ASSERT_EQ(read.observations.size(), 1u);
+  EXPECT_EQ(read.observations[0].cloud->size(), 2u);
+}
+
+TEST_F(Ros1Bag, WithoutTfAPoseTopicIsAskedFor) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    geometry_msgs::PoseStamped pose;
+    pose.header.frame_id = "world";
+    pose.header.stamp = rosTime(1);
+    pose.pose.orientation.w = 1;
+    bag.write("/mocap/pose", rosTime(1), pose);
+    bag.write("/scan", rosTime(1), scanMessage("laser", 1));
+  }
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); },
+                               {"no /tf in the bag", "--pose-topic", "candidates: /mocap/pose"}));
+  BagOptions options;
+  options.pose_topic = "/mocap/pose";
+  const BagSequence read = loadBag(path(), BagVersion::Ros1, options);
+  ASSERT_EQ(read.observations.size(), 1u);
+  EXPECT_EQ(read.fixed_frame, "world");
+  ASSERT_EQ(read.warnings.size(), 1u);  // no mounting: the sensor is at the pose
+  EXPECT_NE(read.warnings[0].find("no /tf_static from the body to the sensor's frame 'laser'"), std::string::npos)
+      << read.warnings[0];
 }
 
 TEST_F(Ros1Bag, AFileThatIsNotABagIsAnInputError) {

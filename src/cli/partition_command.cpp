@@ -56,7 +56,9 @@ std::string detectFormat(const PartitionArgs& args) {
     throw io::UsageError(args.input + ": --format pcd needs a folder of .pcd files");
   if (args.format == "carmen" && folder) throw io::UsageError(args.input + ": --format carmen needs a log file");
   if (args.format == "ros1" && folder) throw io::UsageError(args.input + ": --format ros1 needs a .bag file");
-  if (args.format != "auto" && args.format != "carmen" && args.format != "ros1" && !folder)
+  const bool db3 = fs::path(args.input).extension() == ".db3";
+  if (args.format != "auto" && args.format != "carmen" && args.format != "ros1" && !(args.format == "ros2" && db3) &&
+      !folder)
     throw io::UsageError(args.input + ": --format " + args.format + " needs a folder");
   if (args.format != "auto") return args.format;
   if (const auto bag = io::detectBag(args.input)) return io::toString(*bag);

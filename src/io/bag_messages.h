@@ -8,6 +8,7 @@
 #include <pcl/PCLPointCloud2.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,9 @@ struct Topic {
   std::string type;
   std::size_t messages = 0;
 };
+
+/// What to do with a bag in MCAP storage.
+inline const std::string kConvertToSqlite = "convert the bag to sqlite3 storage with `ros2 bag convert`";
 
 inline constexpr const char* kLaserScanType = "sensor_msgs/LaserScan";
 inline constexpr const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
@@ -111,17 +115,27 @@ void decodeRos2Message(const std::string& type, Role role, const unsigned char* 
 // Checks both backends make of what they decoded (bag_sequence.cpp); each
 // throws InputError starting with `context`.
 
-/// The type is one `role` reads (LaserScan or PointCloud2 for the data,
-/// TFMessage for /tf and /tf_static, Odometry or PoseStamped for poses).
+/// Whether `role` reads `type` (LaserScan or PointCloud2 for the data,
+/// TFMessage for /tf and /tf_static, Odometry or PoseStamped for poses), and
+/// those types in words.
+bool roleAccepts(Role role, const std::string& type);
+const char* typesOfRole(Role role);
+/// roleAccepts, or an InputError.
 void checkRole(const std::string& type, Role role, const std::string& context);
-/// A finite stamp.
-void checkStamp(const Header& header, const std::string& context);
-/// A finite translation and a non-zero finite quaternion (normalised).
+/// The beams' geometry: finite angles, range bounds that are numbers.
+void checkScan(const Scan& scan, const std::string& context);
+/// A finite translation and a non-zero finite quaternion, normalised
+/// (writers round; a few only approximately normalise).
 Eigen::Isometry3d checkedRigid(const Eigen::Vector3d& translation, const Eigen::Quaterniond& rotation,
-                               const std::string& context, const char* translation_field,
-                               const char* rotation_field);
-/// Little-endian data, width * point_step within row_step, row_step * height
-/// bytes of data, each field's datatype known and within point_step.
+                               const std::string& context, const std::string& translation_field,
+                               const std::string& rotation_field);
+/// Bytes of a sensor_msgs/PointField datatype (1 INT8 ... 8 FLOAT64), 0
+/// for any other (PCL's 9, BOOL, is not ROS's).
+std::size_t pointFieldSize(std::uint8_t datatype);
+/// Little-endian data, each field's datatype known and within point_step, a
+/// point_step for any points, width * point_step within row_step, and at
+/// least row_step * height bytes of data: whoever reads a point by its
+/// offsets stays inside the buffer.
 void checkCloudLayout(const pcl::PCLPointCloud2& cloud, const std::string& context);
 
 /// ROS 1 bags (a .bag file). Throw InputError naming the file, the topic

@@ -7,7 +7,6 @@
 #include <obsgroup/io/errors.h>
 
 #include <pcl/PCLPointField.h>
-#include <pcl/common/io.h>
 #include <pcl/conversions.h>
 
 #include <algorithm>
@@ -22,52 +21,96 @@ namespace obsgroup::io {
 
 namespace bag {
 
-void checkRole(const std::string& type, Role role, const std::string& context) {
-  const bool fits = role == Role::Data   ? type == kLaserScanType || type == kPointCloud2Type
-                    : role == Role::Pose ? type == kOdometryType || type == kPoseStampedType
-                                         : type == kTfType;
-  if (fits) return;
-  const char* wanted = role == Role::Data   ? "sensor_msgs/LaserScan or sensor_msgs/PointCloud2"
-                       : role == Role::Pose ? "nav_msgs/Odometry or geometry_msgs/PoseStamped"
-                                            : "tf2_msgs/TFMessage";
-  throw InputError(context + ": a " + type + " where a " + wanted + " is read");
+bool roleAccepts(Role role, const std::string& type) {
+  switch (role) {
+    case Role::Data: return type == kLaserScanType || type == kPointCloud2Type;
+    case Role::Pose: return type == kOdometryType || type == kPoseStampedType;
+    case Role::Tf:
+    case Role::TfStatic: return type == kTfType;
+  }
+  return false;
 }
 
-void checkStamp(const Header& header, const std::string& context) {
-  if (!std::isfinite(header.stamp) || header.stamp < 0)
-    throw InputError(context + ": field header.stamp: not a time");
+const char* typesOfRole(Role role) {
+  switch (role) {
+    case Role::Data: return "sensor_msgs/LaserScan or sensor_msgs/PointCloud2";
+    case Role::Pose: return "nav_msgs/Odometry or geometry_msgs/PoseStamped";
+    case Role::Tf:
+    case Role::TfStatic: return "tf2_msgs/TFMessage";
+  }
+  return "";
 }
+
+void checkRole(const std::string& type, Role role, const std::string& context) {
+  if (!roleAccepts(role, type))
+    throw InputError(context + ": a " + type + " where a " + typesOfRole(role) + " is read");
+}
+
+void checkScan(const Scan& scan, const std::string& context) {
+  auto fail = [&](const char* field, const char* what) { throw InputError(context + ": field " + field + ": " + what); };
+  if (!std::isfinite(scan.angle_min)) fail("angle_min", "not finite");
+  if (!std::isfinite(scan.angle_increment)) fail("angle_increment", "not finite");
+  if (std::isnan(scan.range_min)) fail("range_min", "not a number");
+  if (std::isnan(scan.range_max)) fail("range_max", "not a number");
+}
+
+namespace {
+std::string numbers(const double* values, int n) {
+  std::string text;
+  for (int k = 0; k < n; ++k) text += (k ? " " : "") + std::to_string(values[k]);
+  return text;
+}
+}  // namespace
 
 Eigen::Isometry3d checkedRigid(const Eigen::Vector3d& translation, const Eigen::Quaterniond& rotation,
-                               const std::string& context, const char* translation_field,
-                               const char* rotation_field) {
-  if (!translation.allFinite()) throw InputError(context + ": field " + translation_field + ": not finite");
-  const double norm = rotation.coeffs().norm();
-  if (!std::isfinite(norm) || norm < 1e-6)
-    throw InputError(context + ": field " + rotation_field + ": not a rotation (norm " + std::to_string(norm) + ")");
+                               const std::string& context, const std::string& translation_field,
+                               const std::string& rotation_field) {
+  auto fail = [&](const std::string& field, const std::string& what) {
+    throw InputError(context + ": field " + field + ": " + what);
+  };
+  if (!translation.allFinite()) fail(translation_field, "not finite (" + numbers(translation.data(), 3) + ")");
+  const double norm = rotation.coeffs().norm();  // x y z w
+  if (!std::isfinite(norm)) fail(rotation_field, "not finite (" + numbers(rotation.coeffs().data(), 4) + ")");
+  if (norm < 1e-6) fail(rotation_field, "a zero quaternion (" + numbers(rotation.coeffs().data(), 4) + ") is no rotation");
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = rotation.normalized().toRotationMatrix();
   pose.translation() = translation;
   return pose;
 }
 
+std::size_t pointFieldSize(std::uint8_t datatype) {
+  static constexpr std::size_t sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+  return datatype < 9 ? sizes[datatype] : 0;
+}
+
 void checkCloudLayout(const pcl::PCLPointCloud2& cloud, const std::string& context) {
-  auto fail = [&](const char* field, const std::string& what) {
+  auto fail = [&](const std::string& field, const std::string& what) {
     throw InputError(context + ": field " + field + ": " + what);
   };
   if (cloud.is_bigendian) fail("is_bigendian", "big-endian point data is not supported");
+  for (std::size_t k = 0; k < cloud.fields.size(); ++k) {
+    const pcl::PCLPointField& field = cloud.fields[k];
+    const std::size_t size = pointFieldSize(field.datatype);
+    const std::string name = "fields[" + std::to_string(k) + "]";
+    if (size == 0)
+      fail(name + ".datatype", std::to_string(field.datatype) + " is not a PointField datatype (1 INT8 ... 8 FLOAT64)");
+    // A count of 0 still has readers (PCL) read one element.
+    const std::uint64_t end = std::uint64_t(field.offset) + std::uint64_t(size) * std::max<std::uint32_t>(field.count, 1);
+    if (end > cloud.point_step)
+      fail(name + ".offset", "field '" + field.name + "' (offset " + std::to_string(field.offset) + ", " +
+                                 std::to_string(field.count) + " x " + std::to_string(size) +
+                                 " bytes) ends beyond point_step " + std::to_string(cloud.point_step));
+  }
+  const std::uint64_t points = std::uint64_t(cloud.width) * cloud.height;
+  if (points > 0 && cloud.point_step == 0) fail("point_step", "0 bytes per point for " + std::to_string(points) + " points");
   const std::uint64_t row = std::uint64_t(cloud.width) * cloud.point_step;
   if (row > cloud.row_step)
-    fail("row_step", std::to_string(cloud.row_step) + " is less than width * point_step = " + std::to_string(row));
+    fail("row_step", std::to_string(cloud.row_step) + " bytes, fewer than point_step x width = " +
+                         std::to_string(cloud.point_step) + " x " + std::to_string(cloud.width) + " = " + std::to_string(row));
   const std::uint64_t bytes = std::uint64_t(cloud.row_step) * cloud.height;
-  if (bytes != cloud.data.size())
-    fail("data", std::to_string(cloud.data.size()) + " bytes where row_step * height = " + std::to_string(bytes));
-  for (const pcl::PCLPointField& field : cloud.fields) {
-    const int size = pcl::getFieldSize(field.datatype);
-    if (size == 0) fail("fields.datatype", "'" + field.name + "' has unknown datatype " + std::to_string(field.datatype));
-    if (std::uint64_t(field.offset) + std::uint64_t(size) * std::max<std::uint32_t>(field.count, 1) > cloud.point_step)
-      fail("fields.offset", "'" + field.name + "' ends beyond point_step " + std::to_string(cloud.point_step));
-  }
+  if (bytes > cloud.data.size())
+    fail("data", std::to_string(cloud.data.size()) + " bytes, fewer than row_step x height = " +
+                     std::to_string(cloud.row_step) + " x " + std::to_string(cloud.height) + " = " + std::to_string(bytes));
 }
 
 }  // namespace bag
@@ -252,13 +295,15 @@ void checkPoseTopic(const std::vector<bag::Topic>& topics, const std::string& as
 }
 
 /// A scan's returns as points in its frame (x ahead, y left): finite ranges
-/// within [range_min, range_max].
+/// within [range_min, range_max).
 pcl::PointCloud<pcl::PointXYZ>::Ptr scanPoints(const bag::Scan& scan) {
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   cloud->reserve(scan.ranges.size());
   for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
     const double r = scan.ranges[k];
-    if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max || r <= 0) continue;
+    // As laser_geometry projects scans: range_max itself is the no-return
+    // value of Stage, Gazebo and several drivers.
+    if (!std::isfinite(r) || r < scan.range_min || r >= scan.range_max || r <= 0) continue;
     const double angle = scan.angle_min + double(k) * scan.angle_increment;
     cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
   }
@@ -276,9 +321,11 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr cloudPoints(const bag::Cloud& message, const
       throw InputError(context + ": field fields: '" + axis + "' is not FLOAT32 (datatype " +
                        std::to_string(field->datatype) + ")");
   }
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  // PCL 1.13 indexes the first point of an empty cloud (undefined behaviour).
+  if (std::uint64_t(message.cloud.width) * message.cloud.height == 0) return cloud;
   pcl::PointCloud<pcl::PointXYZ> all;
   pcl::fromPCLPointCloud2(message.cloud, all);
-  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   cloud->reserve(all.size());
   for (const auto& p : all)
     if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) cloud->push_back(p);
@@ -290,7 +337,7 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr cloudPoints(const bag::Cloud& message, const
 class PoseSource {
  public:
   PoseSource(const bag::Messages& messages, const BagOptions& options, const std::string& bag_name,
-             std::vector<std::string>& warnings)
+             const std::vector<bag::Topic>& topics, std::vector<std::string>& warnings)
       : tree_(messages, bag_name), bag_name_(bag_name), warnings_(warnings) {
     if (options.pose_topic) {
       for (const auto& p : messages.poses) {
@@ -304,6 +351,14 @@ class PoseSource {
       return;
     }
     description_ = "/tf";
+    if (messages.tf.empty() && messages.tf_static.empty()) {
+      std::string pose_topics;
+      for (const auto& t : topics)
+        if (t.type == bag::kOdometryType || t.type == bag::kPoseStampedType) pose_topics += " " + t.name;
+      throw InputError(bag_name + ": no /tf in the bag to pose the scans by; give a pose topic with --pose-topic" +
+                       (pose_topics.empty() ? std::string(" (the bag has no nav_msgs/Odometry or geometry_msgs/PoseStamped topic)")
+                                            : " (candidates:" + pose_topics + ")"));
+    }
     fixed_frame_ = options.fixed_frame.value_or("map");
     if (tree_.has(fixed_frame_)) return;
     if (options.fixed_frame || !tree_.has("odom"))
@@ -337,11 +392,12 @@ class PoseSource {
   /// sensor's /tf_static chain. No such transform: the sensor is the body.
   std::optional<Eigen::Isometry3d> mounting(const std::string& sensor, double stamp) {
     const std::string body = body_.empty() ? tree_.staticRoot(sensor) : body_;
-    if (body == sensor) return Eigen::Isometry3d::Identity();
-    if (!tree_.connected(body, sensor)) {
+    if (body == sensor && !body_.empty()) return Eigen::Isometry3d::Identity();  // the odometry is the sensor's
+    if (body == sensor || !tree_.connected(body, sensor)) {
       if (!warned_unmounted_)
-        warnings_.push_back(bag_name_ + ": no /tf_static from '" + body + "' to the sensor's frame '" + sensor +
-                            "': the sensor is taken to be at the poses of " + description_);
+        warnings_.push_back(bag_name_ + ": no /tf_static from " + (body == sensor ? std::string("the body") : "'" + body + "'") +
+                            " to the sensor's frame '" + sensor + "': the sensor is taken to be at the poses of " +
+                            description_);
       warned_unmounted_ = true;
       return Eigen::Isometry3d::Identity();
     }
@@ -399,9 +455,15 @@ std::optional<BagVersion> detectBag(const std::string& path) {
     return std::nullopt;
   }
   std::ifstream in(path, std::ios::binary);
-  char magic[13] = {};
-  in.read(magic, 13);
-  if (in.gcount() == 13 && std::string(magic, 13) == "#ROSBAG V2.0\n") return BagVersion::Ros1;
+  char magic[16] = {};
+  in.read(magic, 16);
+  const std::string start(magic, std::size_t(in.gcount()));
+  if (start.rfind("#ROSBAG V2.0\n", 0) == 0) return BagVersion::Ros1;
+  // One file of a ROS 2 bag: an SQLite database named .db3.
+  if (start == std::string("SQLite format 3\0", 16) && fs::path(path).extension() == ".db3") return BagVersion::Ros2;
+  if (start.rfind("\x89MCAP", 0) == 0)
+    throw InputError(path + ": an MCAP file: MCAP storage is not supported (Debian ships no MCAP library); " +
+                     bag::kConvertToSqlite);
   return std::nullopt;
 }
 
@@ -419,7 +481,7 @@ BagSequence loadBag(const std::string& path, BagVersion version, const BagOption
   sequence.version = version;
   sequence.topic = data.name;
   sequence.message_type = data.type;
-  PoseSource poses(messages, options, path, sequence.warnings);
+  PoseSource poses(messages, options, path, topics, sequence.warnings);
   sequence.pose_source = poses.description();
   sequence.fixed_frame = poses.fixedFrame();
   addObservations(messages.scans, data.name, poses, path, sequence);

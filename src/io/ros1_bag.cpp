@@ -178,15 +178,13 @@ void decodeRos1Message(const std::string& type, Role role, const unsigned char* 
   Ros1Stream in(data, size, context);
   if (type == kLaserScanType) {
     into.scans.push_back({number, readScan(in)});
-    checkStamp(into.scans.back().message.header, context);
+    checkScan(into.scans.back().message, context);
   } else if (type == kPointCloud2Type) {
     into.clouds.push_back({number, readCloud(in)});
-    checkStamp(into.clouds.back().message.header, context);
   } else if (type == kTfType) {
     readTransforms(in, number, role == Role::TfStatic ? into.tf_static : into.tf);
   } else {
     into.poses.push_back({number, readPose(in, type == kOdometryType)});
-    checkStamp(into.poses.back().message.header, context);
   }
 }
 

@@ -48,7 +48,8 @@ struct BagSequence {
 };
 
 /// ROS 1 when `path` is a file starting with "#ROSBAG V2.0", ROS 2 when it
-/// is a folder holding metadata.yaml; else nothing.
+/// is a folder holding metadata.yaml or one .db3 SQLite file of such a
+/// folder; else nothing. An MCAP file is an InputError saying it is not read.
 std::optional<BagVersion> detectBag(const std::string& path);
 
 /// Reads the bag. Throws InputError naming the bag, the topic and the message
