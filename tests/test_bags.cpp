@@ -347,6 +347,10 @@ TEST(Ros1Message, ACloudWhoseDataDoNotFitItsRowsIsRefused) {
   EXPECT_TRUE(throwsMentioning(
       [&] { bag::decodeRos1Message(bag::kPointCloud2Type, bag::Role::Data, bytes.data(), bytes.size(), "c", 1, into); },
       {"field data", "36 bytes, fewer than row_step x height = 40 x 1 = 40"}));
+  cloud.data.assign(44, 0);  // more than row_step * height: read, the rest ignored (as the fuzzer found)
+  bytes = serialised(cloud);
+  bag::decodeRos1Message(bag::kPointCloud2Type, bag::Role::Data, bytes.data(), bytes.size(), "c", 1, into);
+  ASSERT_EQ(into.clouds.size(), 1u);
   cloud.data.assign(40, 0);
   cloud.is_bigendian = true;
   bytes = serialised(cloud);
