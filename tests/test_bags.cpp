@@ -407,6 +407,27 @@ TEST_F(Ros1Bag, WithoutTfAPoseTopicIsAskedFor) {
       << read.warnings[0];
 }
 
+TEST_F(Ros1Bag, ATumTrajectoryPosesTheMessagesByTimestamp) {
+  writeRun();
+  std::ofstream(dir_ / "trajectory.txt") << "# timestamp tx ty tz qx qy qz qw\n"
+                                         << "10.005 1 2 0 0 0 0 1\n11.49 3 4 0 0 0 0.7071067811865476 0.7071067811865476\n";
+  BagOptions options;
+  options.poses_file = (dir_ / "trajectory.txt").string();
+  const BagSequence read = loadBag(path(), BagVersion::Ros1, options);
+  // t=10 and 11.5 have a pose within 0.02 s; 12 and 13 do not.
+  ASSERT_EQ(read.observations.size(), 2u);
+  EXPECT_EQ(read.skipped, 2u);
+  EXPECT_EQ(read.fixed_frame, "");
+  expectPose(read.observations[0].pose, planar(1, 2, 0));
+  expectPose(read.observations[1].pose, planar(3, 4, M_PI / 2), 1e-9);
+  ASSERT_EQ(read.warnings.size(), 1u);
+  EXPECT_NE(read.warnings[0].find("2 of 4 messages on /scan have no pose in"), std::string::npos) << read.warnings[0];
+  options.max_time_difference = 1.6;  // 13 is 1.51 s from 11.49
+  EXPECT_EQ(loadBag(path(), BagVersion::Ros1, options).observations.size(), 4u);
+  options.pose_topic = "/odom";
+  EXPECT_THROW(loadBag(path(), BagVersion::Ros1, options), UsageError);
+}
+
 TEST_F(Ros1Bag, AFileThatIsNotABagIsAnInputError) {
   std::ofstream(path(), std::ios::binary) << "#ROSBAG V2.0\nthis is not a bag at all";
   EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); }, {path(), "not a readable ROS 1 bag"}));

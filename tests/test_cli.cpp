@@ -1075,6 +1075,9 @@ TEST_F(Cli, BagOptionsAndBadBags) {
   EXPECT_NE(cut.err.find("cut.bag"), std::string::npos) << cut.err;
   const Result both = run("partition " + (dir_ / "cut.bag").string() + " --pose-topic /odom --fixed-frame map" + out);
   EXPECT_EQ(both.code, 2);
+  const Result tolerance = run("partition " + (dir_ / "cut.bag").string() + " --max-time-difference 0.1" + out);
+  EXPECT_EQ(tolerance.code, 2);
+  EXPECT_NE(tolerance.err.find("applies to a bag with --poses"), std::string::npos) << tolerance.err;
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 

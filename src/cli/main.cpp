@@ -93,7 +93,8 @@ void addCarmenOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
 void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--poses", args.poses,
                      "PCD: poses file, one line per cloud, or matched by timestamp when the files are named by one "
-                     "(default: each PCD's VIEWPOINT); depth images, KITTI: instead of the folder's")
+                     "(default: each PCD's VIEWPOINT); depth images, KITTI: instead of the folder's; bags: a TUM "
+                     "trajectory of the sensor matched by timestamp, instead of /tf")
       ->group("PCD sequences");
   command.add_option("--pose-format", args.pose_format, "PCD: format of --poses (default: from the column count, 8 "
                                                         "tum, 12 kitti)")
@@ -101,7 +102,8 @@ void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->option_text(choices(io::kPoseFormatNames))
       ->group("PCD sequences");
   command.add_option("--max-time-difference", args.max_time_difference,
-                     "TUM poses matched by timestamp: most seconds between a frame and its pose (default: 0.02)")
+                     "TUM poses matched by timestamp (depth images, PCD, bags): most seconds between a frame and its pose (default: "
+                     "0.02)")
       ->check(finiteNumber(0.0))
       ->group("PCD sequences");
 }

@@ -77,21 +77,22 @@ std::string detectFormat(const PartitionArgs& args) {
 }
 
 void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
-  if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences only");
+  if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences, depth images, KITTI and bags");
   const bool depth = format == "tum-rgbd" || format == "redwood";
   if (!depth && (args.intrinsics || args.depth_scale || args.depth_max || args.stride))
     throw io::UsageError("--intrinsics, --depth-scale, --depth-max and --stride apply to depth images only");
-  if (format != "pcd" && format != "tum-rgbd" && args.max_time_difference)
-    throw io::UsageError("--max-time-difference applies to TUM poses matched by timestamp (tum-rgbd, pcd)");
+  const bool bag = format == "ros1" || format == "ros2";
+  if (format != "pcd" && format != "tum-rgbd" && !bag && args.max_time_difference)
+    throw io::UsageError("--max-time-difference applies to TUM poses matched by timestamp (tum-rgbd, pcd, bags)");
+  if (bag && args.max_time_difference && !args.poses)
+    throw io::UsageError("--max-time-difference applies to a bag with --poses (TUM poses matched by timestamp)");
   if (format != "pcd" && args.pose_format)
     throw io::UsageError("--pose-format applies to PCD sequences (depth images and KITTI have their own)");
   if (format != "carmen" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
   if (format != "carmen" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
-  const bool bag = format == "ros1" || format == "ros2";
   if (!bag && (args.topic || args.pose_topic || args.fixed_frame))
     throw io::UsageError("--topic, --pose-topic and --fixed-frame apply to ROS bags only");
-  if (bag && args.poses) throw io::UsageError("--poses: a bag's poses come from /tf or --pose-topic");
   if (args.pose_topic && args.fixed_frame)
     throw io::UsageError("--fixed-frame applies to poses from /tf; a --pose-topic gives its own frame");
 }
@@ -478,6 +479,8 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   options.topic = args.topic;
   options.pose_topic = args.pose_topic;
   options.fixed_frame = args.fixed_frame;
+  options.poses_file = args.poses;
+  options.max_time_difference = args.max_time_difference.value_or(0.02);
   io::BagSequence sequence = io::loadBag(args.input, version, options);
   InputRecord input;
   input.format = io::toString(version);
@@ -485,9 +488,13 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   input.parameters = {{"topic", sequence.topic},
                       {"message_type", sequence.message_type},
                       {"poses_from", sequence.pose_source},
-                      {"fixed_frame", sequence.fixed_frame},
+                      {"fixed_frame", sequence.fixed_frame.empty() ? nlohmann::json() : nlohmann::json(sequence.fixed_frame)},
                       {"skipped_messages", sequence.skipped},
                       {"point_type", io::toString(io::PointKind::XYZ)}};
+  if (args.poses) {
+    input.parameters["poses"] = *args.poses;
+    input.parameters["max_time_difference"] = options.max_time_difference;
+  }
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
   return runPipeline(args, std::move(sequence.observations), std::move(input));

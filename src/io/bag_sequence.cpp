@@ -5,6 +5,8 @@
 #include "bag_messages.h"
 
 #include <obsgroup/io/errors.h>
+#include <obsgroup/io/input_file.h>
+#include <obsgroup/io/pose_file.h>
 
 #include <pcl/PCLPointField.h>
 #include <pcl/conversions.h>
@@ -339,6 +341,16 @@ class PoseSource {
   PoseSource(const bag::Messages& messages, const BagOptions& options, const std::string& bag_name,
              const std::vector<bag::Topic>& topics, std::vector<std::string>& warnings)
       : tree_(messages, bag_name), bag_name_(bag_name), warnings_(warnings) {
+    if (options.poses_file) {
+      const std::string name = inputName(*options.poses_file);
+      stamped_ = parseStampedPoses(readInputBytes(*options.poses_file, "poses file"), name);
+      std::stable_sort(stamped_.begin(), stamped_.end(),
+                       [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+      tolerance_ = options.max_time_difference;
+      description_ = name;
+      fixed_frame_ = "";  // whatever frame the file's poses are in
+      return;
+    }
     if (options.pose_topic) {
       for (const auto& p : messages.poses) {
         track_.add(p.message.header.stamp, p.message.pose);
@@ -374,6 +386,11 @@ class PoseSource {
 
   /// The sensor's pose at the stamp, or nothing when the poses do not span it.
   std::optional<Eigen::Isometry3d> at(const std::string& sensor, double stamp, const std::string& context) {
+    if (tolerance_) {
+      const auto match = nearestStamp(stamped_, stamp, *tolerance_);
+      if (!match) return std::nullopt;
+      return stamped_[*match].pose;
+    }
     if (description_ == "/tf") {
       if (!tree_.connected(fixed_frame_, sensor))
         throw InputError(context + ": /tf does not connect the sensor's frame '" + sensor + "' to '" + fixed_frame_ + "'");
@@ -406,6 +423,8 @@ class PoseSource {
 
   FrameTree tree_;
   PoseTrack track_;
+  std::vector<StampedPose> stamped_;      // poses file
+  std::optional<double> tolerance_;       // set for a poses file
   std::string body_;
   std::string fixed_frame_;
   std::string description_;
@@ -468,12 +487,14 @@ std::optional<BagVersion> detectBag(const std::string& path) {
 }
 
 BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options) {
+  if (options.pose_topic && options.fixed_frame)
+    throw UsageError("--fixed-frame applies to poses from /tf; a pose topic gives its own frame");
+  if (options.poses_file && (options.pose_topic || options.fixed_frame))
+    throw UsageError("--poses gives the poses itself: no --pose-topic or --fixed-frame with it");
   const bool ros1 = version == BagVersion::Ros1;
   const std::vector<bag::Topic> topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
   const bag::Topic& data = chooseDataTopic(topics, options.topic, path);
   if (options.pose_topic) checkPoseTopic(topics, *options.pose_topic, path);
-  if (options.pose_topic && options.fixed_frame)
-    throw UsageError("--fixed-frame applies to poses from /tf; a pose topic gives its own frame");
   bag::Request request{data.name, options.pose_topic};
   const bag::Messages messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
 
@@ -491,9 +512,12 @@ BagSequence loadBag(const std::string& path, BagVersion version, const BagOption
     throw InputError(path + ": none of the " + std::to_string(total) + " messages on " + data.name +
                      " has a pose from " + poses.description() + " at its stamp");
   if (sequence.skipped > 0)
-    sequence.warnings.push_back(std::to_string(sequence.skipped) + " of " + std::to_string(total) + " messages on " +
-                                data.name + " are outside the time span of " + poses.description() +
-                                " (no pose is extrapolated): skipped");
+    sequence.warnings.push_back(
+        std::to_string(sequence.skipped) + " of " + std::to_string(total) + " messages on " + data.name +
+        (options.poses_file ? " have no pose in " + poses.description() + " within " +
+                                  std::to_string(options.max_time_difference) + " s of their stamp"
+                            : " are outside the time span of " + poses.description() + " (no pose is extrapolated)") +
+        ": skipped");
   return sequence;
 }
 

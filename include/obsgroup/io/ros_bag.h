@@ -33,6 +33,11 @@ struct BagOptions {
   std::optional<std::string> pose_topic;
   /// The frame /tf poses are taken in; default: map, else odom (with a warning).
   std::optional<std::string> fixed_frame;
+  /// A TUM trajectory of the sensor (timestamp tx ty tz qx qy qz qw, gzipped
+  /// or not) instead: each message takes the pose nearest its stamp within
+  /// max_time_difference, as a SLAM system's output would give it.
+  std::optional<std::string> poses_file;
+  double max_time_difference = 0.02;  ///< seconds
 };
 
 struct BagSequence {
@@ -42,9 +47,9 @@ struct BagSequence {
   std::vector<std::string> warnings;
   std::string topic;         ///< the data topic read
   std::string message_type;  ///< sensor_msgs/LaserScan or sensor_msgs/PointCloud2
-  std::string pose_source;   ///< "/tf" or the pose topic
-  std::string fixed_frame;   ///< the frame of the poses
-  std::size_t skipped = 0;   ///< messages with no pose at their stamp (outside the poses' time span)
+  std::string pose_source;   ///< "/tf", the pose topic or the poses file
+  std::string fixed_frame;   ///< the frame of the poses ("" for a poses file: its own)
+  std::size_t skipped = 0;   ///< messages with no pose at their stamp (outside the poses' time span, or none in the file within the tolerance)
 };
 
 /// ROS 1 when `path` is a file starting with "#ROSBAG V2.0", ROS 2 when it
