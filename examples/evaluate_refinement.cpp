@@ -8,8 +8,12 @@
 //                  against the truth, before and after refinement.
 //
 //   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
+//                       [--min-constraint-ratio R]
 // prints the tables, or writes them into FILE between the lines
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
+// --min-constraint-ratio overrides RefinementParameters::min_constraint_ratio
+// (0: every direction of every pair is trusted), to measure what the guard
+// against unconstrained directions does.
 
 #include "floor_plan.h"
 #include "generated_section.h"
@@ -24,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -119,7 +124,7 @@ std::string cell(const Errors& e) {
   return buffer;
 }
 
-std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted) {
+std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, const RefinementParameters& parameters) {
   const Dataset d = makeDataset(key, sensor);
   const std::vector<Eigen::Isometry3d>& input = drifted ? d.drifted : d.truth;
   std::vector<Observation<pcl::PointXYZ>> observations;
@@ -132,6 +137,7 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted) {
   for (Refinement refinement : {Refinement::None, Refinement::Icp, Refinement::Lum}) {
     LocalMapBuilder<pcl::PointXYZ> builder;
     builder.setRefinement(refinement);
+    builder.setRefinementParameters(parameters);
     const auto start = std::chrono::steady_clock::now();
     const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -161,15 +167,18 @@ int main(int argc, char** argv) {
   std::string output;
   std::vector<std::string> buildings{"office", "loop"};
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
+  RefinementParameters parameters;
   for (int a = 1; a + 1 < argc; a += 2) {
     const std::string option = argv[a];
     if (option == "--output") output = argv[a + 1];
     else if (option == "--buildings") buildings = splitList(argv[a + 1]);
+    else if (option == "--min-constraint-ratio") parameters.min_constraint_ratio = std::atof(argv[a + 1]);
     else if (option == "--sensors") {
       sensors.clear();
       for (const auto& s : splitList(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
     } else {
-      std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...]\n";
+      std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...] "
+                   "[--min-constraint-ratio R]\n";
       return 2;
     }
   }
@@ -179,7 +188,7 @@ int main(int argc, char** argv) {
                      : "### Exact input poses: how far refinement moves each member in its map frame\n\n")
          << kHeader;
     for (const auto& key : buildings)
-      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted);
+      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters);
     page << "\n";
   }
   if (output.empty()) {
