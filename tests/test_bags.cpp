@@ -281,6 +281,13 @@ TEST_F(Ros1Bag, PointCloudsKeepTheirFiniteXyzAcrossPaddedRows) {
     cloud.is_dense = false;
     bag.write("/points", rosTime(5), cloud);
   }
+  const BagReader reader(path(), BagVersion::Ros1, {});
+  EXPECT_EQ(reader.pointKind(), PointKind::XYZI);  // the intensity field, FLOAT32
+  const auto with_intensity = reader.observations<pcl::PointXYZI>();
+  ASSERT_EQ(with_intensity.observations.size(), 1u);
+  ASSERT_EQ(with_intensity.observations[0].cloud->size(), 3u);
+  EXPECT_EQ((*with_intensity.observations[0].cloud)[2].intensity, 9.0f);
+  EXPECT_EQ((*with_intensity.observations[0].cloud)[2].x, 7.0f);
   const BagSequence read = loadBag(path(), BagVersion::Ros1);
   EXPECT_EQ(read.message_type, "sensor_msgs/PointCloud2");
   ASSERT_EQ(read.observations.size(), 1u);

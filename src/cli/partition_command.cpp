@@ -468,6 +468,27 @@ int runKitti(const PartitionArgs& args) {
   return runPipeline(args, std::move(sequence.observations), std::move(input));
 }
 
+template <typename PointT>
+int runBagAs(const PartitionArgs& args, const io::BagReader& reader, io::PointKind kind, Clock::time_point start) {
+  io::BagSequenceOf<PointT> sequence = reader.observations<PointT>();
+  InputRecord input;
+  input.format = io::toString(sequence.version);
+  input.labels = std::move(sequence.labels);
+  input.parameters = {{"topic", sequence.topic},
+                      {"message_type", sequence.message_type},
+                      {"poses_from", sequence.pose_source},
+                      {"fixed_frame", sequence.fixed_frame.empty() ? nlohmann::json() : nlohmann::json(sequence.fixed_frame)},
+                      {"skipped_messages", sequence.skipped},
+                      {"point_type", io::toString(kind)}};
+  if (args.poses) {
+    input.parameters["poses"] = *args.poses;
+    input.parameters["max_time_difference"] = args.max_time_difference.value_or(0.02);
+  }
+  input.warnings = std::move(sequence.warnings);
+  input.load_s = secondsSince(start);
+  return runPipeline(args, std::move(sequence.observations), std::move(input));
+}
+
 int runBag(const PartitionArgs& args, io::BagVersion version) {
   const auto start = Clock::now();
   if (!io::bagSupported(version))
@@ -481,23 +502,13 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   options.fixed_frame = args.fixed_frame;
   options.poses_file = args.poses;
   options.max_time_difference = args.max_time_difference.value_or(0.02);
-  io::BagSequence sequence = io::loadBag(args.input, version, options);
-  InputRecord input;
-  input.format = io::toString(version);
-  input.labels = std::move(sequence.labels);
-  input.parameters = {{"topic", sequence.topic},
-                      {"message_type", sequence.message_type},
-                      {"poses_from", sequence.pose_source},
-                      {"fixed_frame", sequence.fixed_frame.empty() ? nlohmann::json() : nlohmann::json(sequence.fixed_frame)},
-                      {"skipped_messages", sequence.skipped},
-                      {"point_type", io::toString(io::PointKind::XYZ)}};
-  if (args.poses) {
-    input.parameters["poses"] = *args.poses;
-    input.parameters["max_time_difference"] = options.max_time_difference;
+  const io::BagReader reader(args.input, version, options);
+  switch (const io::PointKind kind = reader.pointKind()) {
+    case io::PointKind::XYZI: return runBagAs<pcl::PointXYZI>(args, reader, kind, start);
+    case io::PointKind::XYZRGB: return runBagAs<pcl::PointXYZRGB>(args, reader, kind, start);
+    case io::PointKind::XYZ: break;
   }
-  input.warnings = std::move(sequence.warnings);
-  input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(sequence.observations), std::move(input));
+  return runBagAs<pcl::PointXYZ>(args, reader, io::PointKind::XYZ, start);
 }
 
 }  // namespace

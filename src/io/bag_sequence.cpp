@@ -298,8 +298,9 @@ void checkPoseTopic(const std::vector<bag::Topic>& topics, const std::string& as
 
 /// A scan's returns as points in its frame (x ahead, y left): finite ranges
 /// within [range_min, range_max).
-pcl::PointCloud<pcl::PointXYZ>::Ptr scanPoints(const bag::Scan& scan) {
-  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr scanPoints(const bag::Scan& scan) {
+  auto cloud = pcl::make_shared<pcl::PointCloud<PointT>>();
   cloud->reserve(scan.ranges.size());
   for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
     const double r = scan.ranges[k];
@@ -307,13 +308,19 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr scanPoints(const bag::Scan& scan) {
     // value of Stage, Gazebo and several drivers.
     if (!std::isfinite(r) || r < scan.range_min || r >= scan.range_max || r <= 0) continue;
     const double angle = scan.angle_min + double(k) * scan.angle_increment;
-    cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
+    PointT p;
+    p.x = float(r * std::cos(angle));
+    p.y = float(r * std::sin(angle));
+    p.z = 0.0f;
+    cloud->push_back(p);
   }
   return cloud;
 }
 
-/// The finite x, y, z of a PointCloud2, which must have them as FLOAT32.
-pcl::PointCloud<pcl::PointXYZ>::Ptr cloudPoints(const bag::Cloud& message, const std::string& context) {
+/// The points of a PointCloud2 with finite x, y, z (FLOAT32 fields), the
+/// other fields PointT has (intensity, rgb) as PCL maps them.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr cloudPoints(const bag::Cloud& message, const std::string& context) {
   for (const char* axis : {"x", "y", "z"}) {
     const auto field = std::find_if(message.cloud.fields.begin(), message.cloud.fields.end(),
                                     [&](const pcl::PCLPointField& f) { return f.name == axis; });
@@ -323,10 +330,10 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr cloudPoints(const bag::Cloud& message, const
       throw InputError(context + ": field fields: '" + axis + "' is not FLOAT32 (datatype " +
                        std::to_string(field->datatype) + ")");
   }
-  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  auto cloud = pcl::make_shared<pcl::PointCloud<PointT>>();
   // PCL 1.13 indexes the first point of an empty cloud (undefined behaviour).
   if (std::uint64_t(message.cloud.width) * message.cloud.height == 0) return cloud;
-  pcl::PointCloud<pcl::PointXYZ> all;
+  pcl::PointCloud<PointT> all;
   pcl::fromPCLPointCloud2(message.cloud, all);
   cloud->reserve(all.size());
   for (const auto& p : all)
@@ -433,9 +440,9 @@ class PoseSource {
   bool warned_unmounted_ = false;
 };
 
-template <typename Message>
+template <typename PointT, typename Message>
 void addObservations(const std::vector<Numbered<Message>>& messages, const std::string& topic, PoseSource& poses,
-                     const std::string& bag_name, BagSequence& sequence) {
+                     const std::string& bag_name, BagSequenceOf<PointT>& sequence) {
   for (const auto& [number, message] : messages) {
     const std::string label = bag_name + ": message " + std::to_string(number) + " on " + topic;
     if (message.header.frame_id.empty()) throw InputError(label + ": field header.frame_id: empty");
@@ -445,9 +452,9 @@ void addObservations(const std::vector<Numbered<Message>>& messages, const std::
       continue;
     }
     if constexpr (std::is_same_v<Message, bag::Scan>) {
-      sequence.observations.push_back({scanPoints(message), *pose});
+      sequence.observations.push_back({scanPoints<PointT>(message), *pose});
     } else {
-      sequence.observations.push_back({cloudPoints(message, label), *pose});
+      sequence.observations.push_back({cloudPoints<PointT>(message, label), *pose});
     }
     sequence.labels.push_back(label);
   }
@@ -486,39 +493,74 @@ std::optional<BagVersion> detectBag(const std::string& path) {
   return std::nullopt;
 }
 
-BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options) {
+struct BagReader::Contents {
+  std::string path;
+  BagVersion version = BagVersion::Ros1;
+  BagOptions options;
+  std::vector<bag::Topic> topics;
+  bag::Topic data;
+  bag::Messages messages;
+};
+
+BagReader::BagReader(const std::string& path, BagVersion version, const BagOptions& options)
+    : contents_(std::make_unique<Contents>()) {
   if (options.pose_topic && options.fixed_frame)
     throw UsageError("--fixed-frame applies to poses from /tf; a pose topic gives its own frame");
   if (options.poses_file && (options.pose_topic || options.fixed_frame))
     throw UsageError("--poses gives the poses itself: no --pose-topic or --fixed-frame with it");
+  Contents& c = *contents_;
+  c.path = path;
+  c.version = version;
+  c.options = options;
   const bool ros1 = version == BagVersion::Ros1;
-  const std::vector<bag::Topic> topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
-  const bag::Topic& data = chooseDataTopic(topics, options.topic, path);
-  if (options.pose_topic) checkPoseTopic(topics, *options.pose_topic, path);
-  bag::Request request{data.name, options.pose_topic};
-  const bag::Messages messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
+  c.topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
+  c.data = chooseDataTopic(c.topics, options.topic, path);
+  if (options.pose_topic) checkPoseTopic(c.topics, *options.pose_topic, path);
+  const bag::Request request{c.data.name, options.pose_topic};
+  c.messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
+}
 
-  BagSequence sequence;
-  sequence.version = version;
-  sequence.topic = data.name;
-  sequence.message_type = data.type;
-  PoseSource poses(messages, options, path, topics, sequence.warnings);
+BagReader::~BagReader() = default;
+BagReader::BagReader(BagReader&&) noexcept = default;
+BagReader& BagReader::operator=(BagReader&&) noexcept = default;
+
+PointKind BagReader::pointKind() const {
+  const auto& clouds = contents_->messages.clouds;
+  return clouds.empty() ? PointKind::XYZ : pointKindOfFields(clouds.front().message.cloud.fields);
+}
+
+template <typename PointT>
+BagSequenceOf<PointT> BagReader::observations() const {
+  const Contents& c = *contents_;
+  BagSequenceOf<PointT> sequence;
+  sequence.version = c.version;
+  sequence.topic = c.data.name;
+  sequence.message_type = c.data.type;
+  PoseSource poses(c.messages, c.options, c.path, c.topics, sequence.warnings);
   sequence.pose_source = poses.description();
   sequence.fixed_frame = poses.fixedFrame();
-  addObservations(messages.scans, data.name, poses, path, sequence);
-  addObservations(messages.clouds, data.name, poses, path, sequence);
-  const std::size_t total = messages.scans.size() + messages.clouds.size();
+  addObservations(c.messages.scans, c.data.name, poses, c.path, sequence);
+  addObservations(c.messages.clouds, c.data.name, poses, c.path, sequence);
+  const std::size_t total = c.messages.scans.size() + c.messages.clouds.size();
   if (sequence.observations.empty())
-    throw InputError(path + ": none of the " + std::to_string(total) + " messages on " + data.name +
+    throw InputError(c.path + ": none of the " + std::to_string(total) + " messages on " + c.data.name +
                      " has a pose from " + poses.description() + " at its stamp");
   if (sequence.skipped > 0)
     sequence.warnings.push_back(
-        std::to_string(sequence.skipped) + " of " + std::to_string(total) + " messages on " + data.name +
-        (options.poses_file ? " have no pose in " + poses.description() + " within " +
-                                  std::to_string(options.max_time_difference) + " s of their stamp"
-                            : " are outside the time span of " + poses.description() + " (no pose is extrapolated)") +
+        std::to_string(sequence.skipped) + " of " + std::to_string(total) + " messages on " + c.data.name +
+        (c.options.poses_file ? " have no pose in " + poses.description() + " within " +
+                                    std::to_string(c.options.max_time_difference) + " s of their stamp"
+                              : " are outside the time span of " + poses.description() + " (no pose is extrapolated)") +
         ": skipped");
   return sequence;
+}
+
+template BagSequenceOf<pcl::PointXYZ> BagReader::observations<pcl::PointXYZ>() const;
+template BagSequenceOf<pcl::PointXYZI> BagReader::observations<pcl::PointXYZI>() const;
+template BagSequenceOf<pcl::PointXYZRGB> BagReader::observations<pcl::PointXYZRGB>() const;
+
+BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options) {
+  return BagReader(path, version, options).observations<pcl::PointXYZ>();
 }
 
 }  // namespace obsgroup::io

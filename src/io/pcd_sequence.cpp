@@ -136,8 +136,12 @@ PointKind detectPointKind(const std::string& file) {
   pclCall(file, [&] { return reader.readHeader(file, header, origin, orientation, version, type, offset); },
           "cannot parse the PCD header");
   checkCoordinateFields(header, file);
+  return pointKindOfFields(header.fields);
+}
+
+PointKind pointKindOfFields(const std::vector<pcl::PCLPointField>& fields) {
   bool intensity = false, rgb = false;
-  for (const auto& field : header.fields) {
+  for (const auto& field : fields) {
     // Only fields PCL can map onto the point type: anything else is left out.
     intensity = intensity || (field.name == "intensity" && field.datatype == pcl::PCLPointField::FLOAT32 &&
                               field.count == 1);

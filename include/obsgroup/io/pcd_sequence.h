@@ -6,6 +6,8 @@
 
 #include <obsgroup/cloud/observation.h>
 
+#include <pcl/PCLPointField.h>
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +18,11 @@ namespace obsgroup::io {
 enum class PointKind { XYZ, XYZI, XYZRGB };
 
 std::string toString(PointKind kind);
+
+/// The point type a cloud's fields map onto: XYZRGB with an `rgb` or `rgba`
+/// field (FLOAT32 or UINT32), else XYZI with a FLOAT32 `intensity`, else XYZ.
+/// Only fields PCL can map onto the point type count.
+PointKind pointKindOfFields(const std::vector<pcl::PCLPointField>& fields);
 
 /// Natural order of file names: runs of digits compare as numbers.
 bool naturalLess(const std::string& a, const std::string& b);

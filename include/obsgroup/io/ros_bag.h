@@ -9,9 +9,11 @@
 
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
+#include <obsgroup/io/pcd_sequence.h>
 
 #include <pcl/point_types.h>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,9 +42,11 @@ struct BagOptions {
   double max_time_difference = 0.02;  ///< seconds
 };
 
-struct BagSequence {
+/// The observations of a bag, with what was read and how.
+template <typename PointT>
+struct BagSequenceOf {
   BagVersion version = BagVersion::Ros1;
-  std::vector<Observation<pcl::PointXYZ>> observations;  ///< points in the sensor frame, posed in the fixed frame
+  std::vector<Observation<PointT>> observations;  ///< points in the sensor frame, posed in the fixed frame
   std::vector<std::string> labels;  ///< "BAG: message N on TOPIC" of each observation
   std::vector<std::string> warnings;
   std::string topic;         ///< the data topic read
@@ -51,16 +55,49 @@ struct BagSequence {
   std::string fixed_frame;   ///< the frame of the poses ("" for a poses file: its own)
   std::size_t skipped = 0;   ///< messages with no pose at their stamp (outside the poses' time span, or none in the file within the tolerance)
 };
+using BagSequence = BagSequenceOf<pcl::PointXYZ>;
+
+/// A bag read once: the data topic's messages with their poses, as
+/// observations of whichever point type the caller asks for. PointCloud2
+/// fields that map onto the point type (intensity, rgb) are kept; a scan
+/// gives x, y, z only.
+///
+/// \code
+///   obsgroup::io::BagReader bag("run.bag", obsgroup::io::BagVersion::Ros1, {});
+///   if (bag.pointKind() == obsgroup::io::PointKind::XYZI)
+///     auto clouds = bag.observations<pcl::PointXYZI>();  // a lidar's intensities kept
+/// \endcode
+class BagReader {
+ public:
+  /// Reads the bag. Throws InputError naming the bag, the topic and the
+  /// message number (and the field) of anything that cannot be read, a topic
+  /// that is missing or ambiguous (the topics present are listed), a fixed
+  /// frame or mounting that /tf does not hold, or no message with a pose;
+  /// UsageError for options that do not go together.
+  BagReader(const std::string& path, BagVersion version, const BagOptions& options);
+  ~BagReader();
+  BagReader(BagReader&&) noexcept;
+  BagReader& operator=(BagReader&&) noexcept;
+
+  /// The point type the data's fields give (pointKindOfFields of the first
+  /// cloud); XYZ for scans.
+  PointKind pointKind() const;
+
+  /// The posed observations (PointXYZ, PointXYZI, PointXYZRGB).
+  template <typename PointT>
+  BagSequenceOf<PointT> observations() const;
+
+ private:
+  struct Contents;
+  std::unique_ptr<Contents> contents_;
+};
 
 /// ROS 1 when `path` is a file starting with "#ROSBAG V2.0", ROS 2 when it
 /// is a folder holding metadata.yaml or one .db3 SQLite file of such a
 /// folder; else nothing. An MCAP file is an InputError saying it is not read.
 std::optional<BagVersion> detectBag(const std::string& path);
 
-/// Reads the bag. Throws InputError naming the bag, the topic and the message
-/// number (and the field) of anything that cannot be read, a topic that is
-/// missing or ambiguous (the topics present are listed), a fixed frame or
-/// mounting that /tf does not hold, or no message with a pose.
+/// BagReader(path, version, options).observations<pcl::PointXYZ>().
 BagSequence loadBag(const std::string& path, BagVersion version, const BagOptions& options = {});
 
 }  // namespace obsgroup::io
