@@ -1073,6 +1073,7 @@ TEST_F(Cli, BagOptionsAndBadBags) {
   const Result cut = run("partition " + (dir_ / "cut.bag").string() + out);
   EXPECT_EQ(cut.code, 3);
   EXPECT_NE(cut.err.find("cut.bag"), std::string::npos) << cut.err;
+  EXPECT_NE(cut.err.find("rosbag reindex"), std::string::npos) << cut.err;
   const Result both = run("partition " + (dir_ / "cut.bag").string() + " --pose-topic /odom --fixed-frame map" + out);
   EXPECT_EQ(both.code, 2);
   const Result tolerance = run("partition " + (dir_ / "cut.bag").string() + " --max-time-difference 0.1" + out);

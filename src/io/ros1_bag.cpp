@@ -218,11 +218,18 @@ auto withBagErrors(const std::string& path, Action&& action) {
   }
 }
 
+/// The index sits at the end of a bag: a recording stopped before it was
+/// closed has none, and rosbag says only that a read came short.
 void openBag(rosbag::Bag& bag, const std::string& path) {
-  withBagErrors(path, [&] {
-    bag.open(path, rosbag::bagmode::Read);
-    return 0;
-  });
+  try {
+    withBagErrors(path, [&] {
+      bag.open(path, rosbag::bagmode::Read);
+      return 0;
+    });
+  } catch (const InputError& e) {
+    throw InputError(std::string(e.what()) +
+                     " (a recording cut off before it was closed? `rosbag reindex` rebuilds its index)");
+  }
 }
 
 }  // namespace
