@@ -554,9 +554,11 @@ TEST_F(DatasetFolder, TumLayoutMatchesPosesByNearestTimestamp) {
   EXPECT_EQ(sequence.skipped, 1u);
   EXPECT_DOUBLE_EQ(sequence.observations[0].pose.translation().x(), 1.5);  // 0.995 is nearer 1.0 than 0.99
   EXPECT_DOUBLE_EQ(sequence.observations[1].pose.translation().x(), 3.0);
-  EXPECT_TRUE(sequence.observations[1].pose.linear().isApprox(q.toRotationMatrix(), 1e-12));
+  // The groundtruth is the optical frame's; the observation is in the body
+  // frame (x forward, z up): pose * kOpticalInBody is the optical pose again.
+  EXPECT_TRUE((sequence.observations[1].pose.linear() * kOpticalInBody).isApprox(q.toRotationMatrix(), 1e-12));
   EXPECT_NE(sequence.labels[1].find("2.000000.png"), std::string::npos);
-  EXPECT_FLOAT_EQ((*sequence.observations[0].cloud)[0].z, 0.2f);  // 1000 / 5000
+  EXPECT_FLOAT_EQ((*sequence.observations[0].cloud)[0].x, 0.2f);  // 1000 / 5000, straight ahead
   ASSERT_EQ(sequence.warnings.size(), 1u);
   EXPECT_NE(sequence.warnings[0].find("1 of 3 depth frames have no pose"), std::string::npos) << sequence.warnings[0];
   options.max_time_difference = 0.1;
@@ -594,6 +596,40 @@ std::string redwoodBlock(int i, const Eigen::Matrix4d& m) {
 
 }  // namespace
 
+TEST_F(DatasetFolder, ARedwoodWorldWithYUpIsTurnedToPutItOnZ) {
+  png("depth/0.png", 4, 3, ramp());
+  png("depth/1.png", 4, 3, ramp());
+  // Upright cameras in a world with +y up: the image's y axis (down) is the
+  // world's -y; one looks along -z, the other along +x.
+  Eigen::Matrix4d a = Eigen::Matrix4d::Identity(), b = Eigen::Matrix4d::Identity();
+  a.topLeftCorner<3, 3>() << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  b.topLeftCorner<3, 3>() << 0, 0, 1, 0, -1, 0, 1, 0, 0;
+  a.topRightCorner<3, 1>() << 1, 1.5, 2;
+  text("trajectory.log", redwoodBlock(0, a) + redwoodBlock(1, b));
+  EXPECT_EQ(camerasUpAxis({Eigen::Isometry3d(a), Eigen::Isometry3d(b)}), UpAxis::PlusY);
+  const DepthSequence turned = loadDepthSequence(dir_.string(), DepthLayout::Redwood, {});
+  EXPECT_EQ(turned.up, UpAxis::PlusY);
+  ASSERT_EQ(turned.warnings.size(), 1u);
+  EXPECT_NE(turned.warnings[0].find("its world has y up (from the cameras' image axes"), std::string::npos)
+      << turned.warnings[0];
+  for (const auto& o : turned.observations)  // the body frames stand upright in the turned world
+    EXPECT_TRUE(o.pose.linear().col(2).isApprox(Eigen::Vector3d::UnitZ(), 1e-12)) << o.pose.matrix();
+  EXPECT_NEAR(turned.observations[0].pose.translation().z(), 1.5, 1e-12);  // the camera's height
+  // Level: its forward axis lies in the horizontal plane.
+  EXPECT_NEAR(turned.observations[0].pose.linear().col(0).z(), 0.0, 1e-12);
+  DepthOptions keep;
+  keep.up = UpAxis::PlusZ;
+  const DepthSequence kept = loadDepthSequence(dir_.string(), DepthLayout::Redwood, keep);
+  EXPECT_TRUE(kept.warnings.empty());
+  EXPECT_NEAR(kept.observations[0].pose.translation().z(), 2.0, 1e-12);
+  for (UpAxis axis : {UpAxis::PlusX, UpAxis::MinusX, UpAxis::PlusY, UpAxis::MinusY, UpAxis::MinusZ, UpAxis::PlusZ}) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    const int index = axis == UpAxis::PlusX || axis == UpAxis::MinusX ? 0 : axis == UpAxis::PlusY || axis == UpAxis::MinusY ? 1 : 2;
+    v[index] = axis == UpAxis::MinusX || axis == UpAxis::MinusY || axis == UpAxis::MinusZ ? -1 : 1;
+    EXPECT_TRUE((upToZ(axis) * v).isApprox(Eigen::Vector3d::UnitZ(), 1e-12)) << toString(axis);
+  }
+}
+
 TEST_F(DatasetFolder, RedwoodLayoutPosesEachImageInNameOrder) {
   png("depth/2.png", 4, 3, ramp());
   png("depth/10.png", 4, 3, std::vector<std::uint16_t>(12, 2000));
@@ -603,14 +639,24 @@ TEST_F(DatasetFolder, RedwoodLayoutPosesEachImageInNameOrder) {
   b.topRightCorner<3, 1>() << -1, 0, 0.5;
   text("trajectory.log", redwoodBlock(0, a) + redwoodBlock(1, b));
   ASSERT_EQ(detectDepthLayout(dir_.string()), DepthLayout::Redwood);
-  const DepthSequence sequence = loadDepthSequence(dir_.string(), DepthLayout::Redwood, {});
+  DepthOptions as_given;  // these cameras look along z with y down: auto would turn -y up onto z
+  as_given.up = UpAxis::PlusZ;
+  const DepthSequence sequence = loadDepthSequence(dir_.string(), DepthLayout::Redwood, as_given);
   EXPECT_EQ(sequence.depth_scale, 1000.0);
   ASSERT_EQ(sequence.observations.size(), 2u);
-  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(a, 1e-12));
-  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(b, 1e-12));
+  Eigen::Matrix4d body = Eigen::Matrix4d::Identity();
+  body.topLeftCorner<3, 3>() = kOpticalInBody.transpose();
+  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(a * body, 1e-12));
+  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(b * body, 1e-12));
   EXPECT_NE(sequence.labels[1].find("10.png"), std::string::npos);  // 2 before 10
   EXPECT_EQ(sequence.observations[1].cloud->size(), 12u);
-  EXPECT_FLOAT_EQ((*sequence.observations[1].cloud)[0].z, 2.0f);
+  EXPECT_FLOAT_EQ((*sequence.observations[1].cloud)[0].x, 2.0f);
+  // The same point in the world as the optical frame's back-projection gives.
+  const Eigen::Vector3f optical = backProject(readDepthPng((dir_ / "depth" / "10.png").string()), {}, 1000.0,
+                                              std::nullopt, 1)->points[5].getVector3fMap();
+  const Eigen::Vector3f body_point = (*sequence.observations[1].cloud)[5].getVector3fMap();
+  EXPECT_TRUE((sequence.observations[1].pose * body_point.cast<double>())
+                  .isApprox(Eigen::Isometry3d(b) * optical.cast<double>(), 1e-6));
 
   text("trajectory.log", redwoodBlock(0, a));
   std::string message = errorOf([&] { loadDepthSequence(dir_.string(), DepthLayout::Redwood, {}); });
@@ -641,7 +687,7 @@ void writeBin(const fs::path& file, const std::vector<float>& values) {
 
 }  // namespace
 
-TEST_F(DatasetFolder, KittiLidarPosesAreCameraPosesTimesTr) {
+TEST_F(DatasetFolder, KittiLidarPosesAreCameraPosesInTheFirstVelodyneFrame) {
   writeBin(dir_ / "velodyne" / "000000.bin", {1, 2, 3, 0.5f, 4, 5, 6, 0.25f});
   writeBin(dir_ / "velodyne" / "000001.bin", {7, 8, 9, 1});
   // The usual Tr: velodyne x forward, y left, z up to camera z forward, x right, y down; plus an offset.
@@ -654,8 +700,12 @@ TEST_F(DatasetFolder, KittiLidarPosesAreCameraPosesTimesTr) {
   tr << 0, -1, 0, -0.01, 0, 0, -1, -0.08, 1, 0, 0, -0.27, 0, 0, 0, 1;
   Eigen::Matrix4d cam1;
   cam1 << 0, 0, 1, 2, 0, 1, 0, 0, -1, 0, 0, 5, 0, 0, 0, 1;
-  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(tr, 1e-12));
-  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(cam1 * tr, 1e-12));
+  // Tr^-1 P Tr: the first scan is the world's origin, z up; the camera's
+  // turn about its y axis (down) is a turn about the lidar's -z.
+  EXPECT_TRUE(sequence.observations[0].pose.matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-12));
+  EXPECT_TRUE(sequence.observations[1].pose.matrix().isApprox(tr.inverse() * cam1 * tr, 1e-12));
+  EXPECT_NEAR(sequence.observations[1].pose.linear()(2, 2), 1.0, 1e-12);  // still upright
+  EXPECT_NEAR(sequence.observations[1].pose.translation().z(), 0.0, 1e-12);  // on the same ground
   ASSERT_EQ(sequence.observations[0].cloud->size(), 2u);
   const pcl::PointXYZI& p = (*sequence.observations[0].cloud)[1];
   EXPECT_EQ(p.x, 4.0f);

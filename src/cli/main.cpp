@@ -121,6 +121,12 @@ void addDepthOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--depth-max", args.depth_max, "depth images: deeper pixels are no return, metres (default: none)")
       ->check(finiteNumber(0.0, true))
       ->group("Depth images");
+  command.add_option("--up", args.up,
+                     "depth images: the axis of the trajectory's world that points up, turned onto z (default: z for "
+                     "tum-rgbd, auto for redwood: from the cameras' image axes)")
+      ->transform(oneOf(io::kUpAxisNames))
+      ->option_text(choices(io::kUpAxisNames))
+      ->group("Depth images");
   command.add_option("--stride", args.stride, "depth images: every Nth pixel in each direction (default: 1)")
       ->check(wholeNumber(1))
       ->group("Depth images");

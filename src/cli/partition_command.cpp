@@ -79,8 +79,8 @@ std::string detectFormat(const PartitionArgs& args) {
 void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format == "carmen" && args.poses) throw io::UsageError("--poses applies to PCD sequences, depth images, KITTI and bags");
   const bool depth = format == "tum-rgbd" || format == "redwood";
-  if (!depth && (args.intrinsics || args.depth_scale || args.depth_max || args.stride))
-    throw io::UsageError("--intrinsics, --depth-scale, --depth-max and --stride apply to depth images only");
+  if (!depth && (args.intrinsics || args.depth_scale || args.depth_max || args.stride || args.up))
+    throw io::UsageError("--intrinsics, --depth-scale, --depth-max, --stride and --up apply to depth images only");
   const bool bag = format == "ros1" || format == "ros2";
   if (format != "pcd" && format != "tum-rgbd" && !bag && args.max_time_difference)
     throw io::UsageError("--max-time-difference applies to TUM poses matched by timestamp (tum-rgbd, pcd, bags)");
@@ -434,6 +434,7 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
   options.stride = args.stride.value_or(1);
   options.max_time_difference = args.max_time_difference.value_or(0.02);
   options.poses = args.poses;
+  options.up = args.up;
   io::DepthSequence sequence = io::loadDepthSequence(args.input, layout, options);
   InputRecord input;
   input.format = io::toString(layout);
@@ -443,6 +444,7 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
                       {"depth_scale", sequence.depth_scale},
                       {"depth_max", args.depth_max ? nlohmann::json(*args.depth_max) : nlohmann::json()},
                       {"stride", options.stride},
+                      {"up_axis", io::toString(sequence.up)},
                       {"point_type", io::toString(io::PointKind::XYZ)}};
   if (layout == io::DepthLayout::TumRgbd) {
     input.parameters["max_time_difference"] = options.max_time_difference;

@@ -3,6 +3,7 @@
 // its observations and write the results.
 
 #include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/depth_sequence.h>
 #include <obsgroup/io/pose_file.h>
 
 #include <obsgroup/maps/local_map_builder.h>
@@ -33,6 +34,7 @@ struct PartitionArgs {
   std::optional<double> depth_scale;      ///< units per metre; default from the layout
   std::optional<double> depth_max;        ///< metres
   std::optional<int> stride;              ///< every Nth pixel in u and v
+  std::optional<io::UpAxis> up;           ///< the trajectory world's up axis
   // ROS bags
   std::optional<std::string> topic;        ///< LaserScan or PointCloud2 topic
   std::optional<std::string> pose_topic;   ///< Odometry or PoseStamped topic

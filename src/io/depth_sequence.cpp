@@ -275,10 +275,29 @@ std::vector<std::string> listPngFiles(const fs::path& folder) {
   return files;
 }
 
-void addFrame(DepthSequence& out, const std::string& file, const Eigen::Isometry3d& pose, const DepthOptions& options) {
+/// Turns the world so that `up` is z, and says so when that is not the identity.
+void putUpOnZ(std::vector<Eigen::Isometry3d>& optical_poses, UpAxis up, bool chosen, const std::string& trajectory,
+              DepthSequence& out) {
+  out.up = up;
+  if (up == UpAxis::PlusZ) return;
+  const Eigen::Matrix3d turn = upToZ(up);
+  for (auto& pose : optical_poses) pose.prerotate(turn);
+  out.warnings.push_back(trajectory + ": its world has " + toString(up) + " up (" +
+                         (chosen ? std::string("--up") : "from the cameras' image axes; --up z keeps it as it is") +
+                         "): turned to put it on z, as obsgroup's height band and pictures from above assume");
+}
+
+void addFrame(DepthSequence& out, const std::string& file, const Eigen::Isometry3d& optical_pose,
+              const DepthOptions& options) {
   const DepthImage image = readDepthPng(file);
   auto cloud = backProject(image, options.intrinsics, out.depth_scale, options.max_depth, options.stride);
   if (cloud->empty()) out.warnings.push_back(file + ": the depth image has no valid pixel; kept as an observation (a group of its own)");
+  // Into the camera's body frame, where the local maps are drawn from above
+  // and the pose arrows point where the camera looks; the world points stay.
+  const Eigen::Matrix3f to_body = kOpticalInBody.cast<float>();
+  for (auto& p : cloud->points) p.getVector3fMap() = to_body * p.getVector3fMap();
+  Eigen::Isometry3d pose = optical_pose;
+  pose.linear() = optical_pose.linear() * kOpticalInBody.transpose();
   cloud->sensor_origin_ << pose.translation().cast<float>(), 0.0f;
   cloud->sensor_orientation_ = Eigen::Quaternionf(pose.linear().cast<float>());
   out.observations.push_back({cloud, pose});
@@ -298,14 +317,20 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
     std::vector<StampedPose> poses = readStampedPoses(truth);
     std::stable_sort(poses.begin(), poses.end(),
                      [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+    std::vector<std::string> files;
+    std::vector<Eigen::Isometry3d> matched;
     for (const DepthFrame& frame : frames) {
       const auto match = nearestStamp(poses, frame.stamp, options.max_time_difference);
       if (!match) {
         ++out.skipped;
         continue;
       }
-      addFrame(out, frame.file, poses[*match].pose, options);
+      files.push_back(frame.file);
+      matched.push_back(poses[*match].pose);
     }
+    const UpAxis up = options.up.value_or(UpAxis::PlusZ);
+    putUpOnZ(matched, up == UpAxis::Auto ? camerasUpAxis(matched) : up, options.up.has_value(), truth, out);
+    for (std::size_t k = 0; k < files.size(); ++k) addFrame(out, files[k], matched[k], options);
     if (out.observations.empty())
       throw InputError(truth + ": no pose within " + std::to_string(options.max_time_difference) +
                        " s of any of the " + std::to_string(frames.size()) +
@@ -318,7 +343,7 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
   }
   const std::vector<std::string> files = listPngFiles(dir / "depth");
   const std::string log = options.poses.value_or((dir / "trajectory.log").string());
-  const std::vector<Eigen::Isometry3d> poses = parseTrajectoryLog(readInputBytes(log, "trajectory"), inputName(log));
+  std::vector<Eigen::Isometry3d> poses = parseTrajectoryLog(readInputBytes(log, "trajectory"), inputName(log));
   if (poses.size() < files.size())
     throw InputError(log + ": " + std::to_string(poses.size()) + " trajectory entries for " +
                      std::to_string(files.size()) + " depth images (one 5-line block per image, in name order)");
@@ -326,8 +351,36 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
     out.warnings.push_back(log + ": " + std::to_string(poses.size()) + " trajectory entries for " +
                            std::to_string(files.size()) + " depth images; the last " +
                            std::to_string(poses.size() - files.size()) + " are not used");
+  poses.resize(std::min(poses.size(), files.size()));
+  const UpAxis up = options.up.value_or(UpAxis::Auto);
+  putUpOnZ(poses, up == UpAxis::Auto ? camerasUpAxis(poses) : up, options.up.has_value(), log, out);
   for (std::size_t k = 0; k < files.size(); ++k) addFrame(out, files[k], poses[k], options);
   return out;
+}
+
+Eigen::Matrix3d upToZ(UpAxis axis) {
+  const double quarter = 1.5707963267948966;
+  switch (axis) {
+    case UpAxis::PlusX: return Eigen::AngleAxisd(-quarter, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    case UpAxis::MinusX: return Eigen::AngleAxisd(quarter, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    case UpAxis::PlusY: return Eigen::AngleAxisd(quarter, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::MinusY: return Eigen::AngleAxisd(-quarter, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::MinusZ: return Eigen::AngleAxisd(2 * quarter, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    case UpAxis::PlusZ:
+    case UpAxis::Auto: break;
+  }
+  return Eigen::Matrix3d::Identity();
+}
+
+UpAxis camerasUpAxis(const std::vector<Eigen::Isometry3d>& optical_poses) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const auto& pose : optical_poses) up -= pose.linear().col(1);  // the image's y axis points down
+  if (up.isZero()) return UpAxis::PlusZ;
+  Eigen::Index axis = 0;
+  up.cwiseAbs().maxCoeff(&axis);
+  static const UpAxis plus[] = {UpAxis::PlusX, UpAxis::PlusY, UpAxis::PlusZ};
+  static const UpAxis minus[] = {UpAxis::MinusX, UpAxis::MinusY, UpAxis::MinusZ};
+  return up[axis] > 0 ? plus[axis] : minus[axis];
 }
 
 }  // namespace obsgroup::io

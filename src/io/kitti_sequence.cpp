@@ -92,7 +92,11 @@ KittiSequence loadKittiSequence(const std::string& folder, const std::optional<s
     const std::string& file = scans[k];
     auto cloud = decodeKittiScan(readInputBytes(file, "velodyne scan"), file);
     if (cloud->empty()) out.warnings.push_back(file + ": the scan has no point; kept as an observation (a group of its own)");
-    const Eigen::Isometry3d pose = camera[k] * tr;
+    // KITTI's world is camera 0 at the start: y down, z ahead. Expressed in
+    // the first velodyne frame instead (Tr^-1 P Tr, as lidar odometry
+    // evaluates KITTI), z is up, which the height band of the sensed regions,
+    // the 2D/3D decision and the pictures from above take it to be.
+    const Eigen::Isometry3d pose = tr.inverse() * camera[k] * tr;
     cloud->sensor_origin_ << pose.translation().cast<float>(), 0.0f;
     cloud->sensor_orientation_ = Eigen::Quaternionf(pose.linear().cast<float>());
     out.observations.push_back({cloud, pose});

@@ -3,8 +3,13 @@
 // RGB-D layout (depth.txt, depth/, groundtruth.txt matched by timestamp) and
 // the Redwood/Open3D layout (depth/*.png, trajectory.log).
 //
-// Camera frame: z forward (the optical axis), x right, y down. Pixel (u, v)
-// with depth d metres is the point ((u - cx) d / fx, (v - cy) d / fy, d).
+// Camera (optical) frame: z forward (the optical axis), x right, y down.
+// Pixel (u, v) with depth d metres is the point ((u - cx) d / fx,
+// (v - cy) d / fy, d) there (backProject). The observations of a sequence are
+// in the camera's body frame instead (x forward, y left, z up, as ROS's REP
+// 103 has a camera_link beside its optical frame), posed accordingly: the
+// same points in the world, and the local maps and pose arrows then read as
+// from above.
 
 #include "obsgroup/io/pose_file.h"
 
@@ -12,6 +17,8 @@
 #include <obsgroup/common/enum_names.h>
 
 #include <pcl/point_types.h>
+
+#include <Eigen/Core>
 
 #include <cstdint>
 #include <optional>
@@ -29,6 +36,9 @@ inline std::string toString(DepthLayout layout) { return nameOf(kDepthLayoutName
 
 /// Units of the PNG per metre when --depth-scale is not given.
 double defaultDepthScale(DepthLayout layout);  // 5000 TUM, 1000 Redwood
+
+/// The optical frame's axes in the body frame: body = kOpticalInBody * optical.
+inline const Eigen::Matrix3d kOpticalInBody = (Eigen::Matrix3d() << 0, 0, 1, -1, 0, 0, 0, -1, 0).finished();
 
 struct PinholeIntrinsics {
   double fx = 525.0, fy = 525.0, cx = 319.5, cy = 239.5;  // PrimeSense, as both datasets document
@@ -50,6 +60,28 @@ struct DepthImage {
 DepthImage decodeDepthPng(std::string_view bytes, const std::string& name);
 DepthImage readDepthPng(const std::string& path);
 
+/// Which axis of a trajectory's world points up: obsgroup's world has z up
+/// (the height band of the sensed regions, the 2D/3D decision, the pictures
+/// from above), and the reader turns the world so. Auto: the coordinate axis
+/// nearest the cameras' mean up direction (the opposite of the image's y
+/// axis, which points down in an upright camera), for worlds no convention
+/// fixes (Redwood/Open3D reconstructions put y or -y up).
+enum class UpAxis { Auto, PlusX, MinusX, PlusY, MinusY, PlusZ, MinusZ };
+
+inline constexpr EnumName<UpAxis> kUpAxisNames[] = {{UpAxis::Auto, "auto"}, {UpAxis::PlusX, "x"},
+                                                    {UpAxis::MinusX, "-x"}, {UpAxis::PlusY, "y"},
+                                                    {UpAxis::MinusY, "-y"}, {UpAxis::PlusZ, "z"},
+                                                    {UpAxis::MinusZ, "-z"}};
+inline std::string toString(UpAxis axis) { return nameOf(kUpAxisNames, axis); }
+
+/// The rotation taking `axis` (not Auto) to +z: a quarter or half turn about
+/// a coordinate axis, the identity for z.
+Eigen::Matrix3d upToZ(UpAxis axis);
+
+/// The coordinate axis nearest the mean of -R_k * (0, 1, 0) over the optical
+/// poses (the cameras' up); z when there are none.
+UpAxis camerasUpAxis(const std::vector<Eigen::Isometry3d>& optical_poses);
+
 struct DepthOptions {
   PinholeIntrinsics intrinsics;
   std::optional<double> depth_scale;  ///< units per metre; default from the layout
@@ -57,6 +89,9 @@ struct DepthOptions {
   int stride = 1;                     ///< every stride-th pixel in u and v
   double max_time_difference = 0.02;  ///< TUM: seconds between a frame and its pose
   std::optional<std::string> poses;   ///< TUM: instead of groundtruth.txt
+  /// The world's up axis; default: z for TUM (its motion-capture world has
+  /// z up), Auto for Redwood.
+  std::optional<UpAxis> up;
 };
 
 /// The points of an image; value 0 is no return, as is a depth beyond
@@ -80,6 +115,7 @@ struct DepthSequence {
   std::vector<std::string> labels;  ///< the PNG of each observation
   std::vector<std::string> warnings;
   std::size_t skipped = 0;  ///< TUM frames without a pose within the tolerance
+  UpAxis up = UpAxis::PlusZ;  ///< the trajectory's up axis (the world was turned to put it on z)
 };
 
 /// Reads the folder in `layout`. TUM: frames without a groundtruth pose

@@ -1,7 +1,9 @@
 #pragma once
 // KITTI odometry: velodyne/*.bin (float32 x y z reflectance per point),
 // poses.txt (camera 0, 3x4 row-major per line) and calib.txt (Tr: the
-// velodyne-to-camera transform). The lidar's pose is pose_cam * Tr.
+// velodyne-to-camera transform). The lidar's pose is Tr^-1 * pose_cam * Tr:
+// the world is the first velodyne frame (x ahead, y left, z up), not camera
+// 0's (z ahead, y down), so that z is up as obsgroup assumes.
 
 #include <obsgroup/cloud/observation.h>
 
