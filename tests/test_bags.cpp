@@ -298,6 +298,47 @@ TEST_F(Ros1Bag, PointCloudsKeepTheirFiniteXyzAcrossPaddedRows) {
   expectPose(read.observations[0].pose, planar(1, 2, 0));
 }
 
+TEST_F(Ros1Bag, CloudsInAnOpticalFrameAreTurnedIntoTheBodyFrame) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    // A camera 1 m up looking along the world's x: its optical z is the world's x, its y the world's -z.
+    Eigen::Isometry3d optical = Eigen::Isometry3d::Identity();
+    optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+    optical.translation() << 0, 0, 1;
+    tf.transforms.push_back(transformMessage("map", "camera_depth_optical_frame", 5, optical));
+    bag.write("/tf", rosTime(5), tf);
+    sensor_msgs::PointCloud2 cloud;
+    cloud.header.frame_id = "camera_depth_optical_frame";
+    cloud.header.stamp = rosTime(5);
+    cloud.height = 1;
+    cloud.width = 1;
+    for (const char* axis : {"x", "y", "z"}) {
+      sensor_msgs::PointField f;
+      f.name = axis;
+      f.offset = std::uint32_t(4 * cloud.fields.size());
+      f.datatype = sensor_msgs::PointField::FLOAT32;
+      f.count = 1;
+      cloud.fields.push_back(f);
+    }
+    cloud.point_step = cloud.row_step = 12;
+    const float point[3] = {0.5f, -0.25f, 2.0f};  // right 0.5, up 0.25, 2 m ahead
+    cloud.data.resize(12);
+    std::memcpy(cloud.data.data(), point, 12);
+    bag.write("/camera/depth/points", rosTime(5), cloud);
+  }
+  const BagSequence read = loadBag(path(), BagVersion::Ros1);
+  ASSERT_EQ(read.observations.size(), 1u);
+  const auto& o = read.observations[0];
+  const pcl::PointXYZ& p = (*o.cloud)[0];
+  EXPECT_FLOAT_EQ(p.x, 2.0f);    // ahead
+  EXPECT_FLOAT_EQ(p.y, -0.5f);   // right is -y
+  EXPECT_FLOAT_EQ(p.z, 0.25f);   // up
+  expectPose(o.pose, Eigen::Isometry3d(Eigen::Translation3d(0, 0, 1)), 1e-12);  // upright, looking along x
+  const Eigen::Vector3d world = o.pose * p.getVector3fMap().cast<double>();
+  EXPECT_TRUE(world.isApprox(Eigen::Vector3d(2, -0.5, 1.25), 1e-6)) << world.transpose();
+}
+
 /// The serialised bytes of a ROS 1 message, as a bag holds them.
 template <typename Message>
 std::vector<unsigned char> serialised(const Message& message) {

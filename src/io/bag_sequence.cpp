@@ -4,6 +4,7 @@
 
 #include "bag_messages.h"
 
+#include <obsgroup/io/depth_sequence.h>
 #include <obsgroup/io/errors.h>
 #include <obsgroup/io/input_file.h>
 #include <obsgroup/io/pose_file.h>
@@ -341,6 +342,15 @@ typename pcl::PointCloud<PointT>::Ptr cloudPoints(const bag::Cloud& message, con
   return cloud;
 }
 
+/// REP 103: a frame named *_optical_frame (or *_optical) has z forward, x
+/// right, y down.
+bool isOpticalFrame(const std::string& frame) {
+  const auto endsWith = [&](const std::string& tail) {
+    return frame.size() >= tail.size() && frame.compare(frame.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  return endsWith("_optical_frame") || endsWith("_optical");
+}
+
 /// Where the poses come from: /tf in a fixed frame, or a pose topic and the
 /// sensor's mounting on the body it gives.
 class PoseSource {
@@ -454,7 +464,14 @@ void addObservations(const std::vector<Numbered<Message>>& messages, const std::
     if constexpr (std::is_same_v<Message, bag::Scan>) {
       sequence.observations.push_back({scanPoints<PointT>(message), *pose});
     } else {
-      sequence.observations.push_back({cloudPoints<PointT>(message, label), *pose});
+      auto cloud = cloudPoints<PointT>(message, label);
+      Eigen::Isometry3d body_pose = *pose;
+      if (isOpticalFrame(message.header.frame_id)) {  // as depth images: into the body frame, z up
+        const Eigen::Matrix3f to_body = kOpticalInBody.cast<float>();
+        for (auto& p : cloud->points) p.getVector3fMap() = to_body * p.getVector3fMap();
+        body_pose.linear() = pose->linear() * kOpticalInBody.transpose();
+      }
+      sequence.observations.push_back({cloud, body_pose});
     }
     sequence.labels.push_back(label);
   }
