@@ -1,7 +1,9 @@
 // Links against an installed obsgroup: two overlapping line scans and one
 // far away give two groups, each coloured with PCL's visualization module;
-// then the same three scans as a CARMEN log, read with obsgroup::io.
+// then the same three scans as a CARMEN log, read with obsgroup::io; and,
+// when given one, a ROS bag (argv[1]) read with obsgroup::io's BagReader.
 #include <obsgroup/io/carmen_reader.h>
+#include <obsgroup/io/ros_bag.h>
 #include <obsgroup/observation_grouping.h>
 
 #include <pcl/point_types.h>
@@ -10,7 +12,7 @@
 #include <cstdio>
 #include <string>
 
-int main() {
+int main(int argc, char** argv) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr line(new pcl::PointCloud<pcl::PointXYZ>);
   for (int k = 0; k < 100; ++k) line->push_back({0.05f * k, 0.0f, 0.0f});
   obsgroup::ObservationGrouping<pcl::PointXYZ> grouping;
@@ -35,8 +37,20 @@ int main() {
   const auto log_partition = from_log.compute();
   std::printf("package consumer: %zu scans read with obsgroup::io, %zu groups\n", read.scans.size(),
               log_partition.groups.size());
+  bool bag_ok = true;
+  if (argc > 1) {
+    const auto version = obsgroup::io::detectBag(argv[1]);
+    const obsgroup::io::BagSequence bag =
+        obsgroup::io::BagReader(argv[1], version.value_or(obsgroup::io::BagVersion::Ros1), {}).observations<pcl::PointXYZ>();
+    obsgroup::ObservationGrouping<pcl::PointXYZ> from_bag;
+    for (const auto& o : bag.observations) from_bag.addObservation(o.cloud, o.pose);
+    const auto bag_partition = from_bag.compute();
+    std::printf("package consumer: %zu scans read from %s with obsgroup::io, %zu groups\n", bag.observations.size(),
+                bag.topic.c_str(), bag_partition.groups.size());
+    bag_ok = version.has_value() && !bag.observations.empty() && !bag_partition.groups.empty();
+  }
   return partition.groups.size() == 2 && colour.isCapable() && read.scans.size() == 3 &&
-                 log_partition.groups.size() == 2
+                 log_partition.groups.size() == 2 && bag_ok
              ? 0
              : 1;
 }
