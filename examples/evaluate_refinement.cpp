@@ -8,12 +8,13 @@
 //                  against the truth, before and after refinement.
 //
 //   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
-//                       [--min-constraint-ratio R]
+//                       [--min-constraint-ratio R] [--point-neighbours N]
 // prints the tables, or writes them into FILE between the lines
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
 // --min-constraint-ratio overrides RefinementParameters::min_constraint_ratio
 // (0: every direction of every pair is trusted), to measure what the guard
-// against unconstrained directions does.
+// against unconstrained directions does; --point-neighbours overrides
+// RefinementParameters::point_neighbours (0: Lum pairs by W alone).
 
 #include "floor_plan.h"
 #include "generated_section.h"
@@ -173,12 +174,13 @@ int main(int argc, char** argv) {
     if (option == "--output") output = argv[a + 1];
     else if (option == "--buildings") buildings = splitList(argv[a + 1]);
     else if (option == "--min-constraint-ratio") parameters.min_constraint_ratio = std::atof(argv[a + 1]);
+    else if (option == "--point-neighbours") parameters.point_neighbours = std::atoi(argv[a + 1]);
     else if (option == "--sensors") {
       sensors.clear();
       for (const auto& s : splitList(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
     } else {
       std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...] "
-                   "[--min-constraint-ratio R]\n";
+                   "[--min-constraint-ratio R] [--point-neighbours N]\n";
       return 2;
     }
   }

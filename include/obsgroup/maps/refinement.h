@@ -61,8 +61,15 @@ struct RefinementParameters {
   /// matches (sum of squared normal components) is left to the input pose: a
   /// corridor seen without its ends does not say where along it the robot was.
   double min_constraint_ratio = 0.02;
-  /// Lum: each member is aligned with up to this many of its most overlapping members.
+  /// Lum: each member is aligned with up to this many of its most overlapping members (by W).
   int neighbours = 5;
+  /// Lum, planar scans: and with up to this many of the members whose points
+  /// share the most cells of `point_overlap_cell` metres with its own at the
+  /// input poses. W pairs views of one place, which a forward laser turned the
+  /// other way in a corridor shares no surface with: those pairs are refused,
+  /// and members hang on partial constraints (docs/refinement.md measures it).
+  int point_neighbours = 2;
+  double point_overlap_cell = 0.5;
 };
 
 /// What refinement did to one local map.

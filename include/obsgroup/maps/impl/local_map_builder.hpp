@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <queue>
 #include <set>
 #include <stdexcept>
@@ -77,6 +78,67 @@ inline std::vector<std::pair<int, int>> maximumSpanningTree(const LocalMapFrame&
   return order;
 }
 
+/// How much the members' points share space at their poses in the map
+/// frame, indexed like W by observation: for each pair with points in a
+/// common cell of `cell` metres, shared cells / sqrt(cells of each).
+inline WeightMatrix pointOverlap(const LocalMapFrame& frame, const std::vector<MemberPoints>& points, double cell,
+                                 Eigen::Index size) {
+  std::vector<std::pair<std::uint64_t, int>> cells;  // (cell key, member position)
+  std::vector<double> counts(points.size(), 0.0);
+  const auto index = [cell](double v) { return std::uint64_t(std::int64_t(std::floor(v / cell)) + (1 << 20)) & 0x1FFFFF; };
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    std::vector<std::uint64_t> keys;
+    keys.reserve(points[k].size());
+    for (const auto& p : points[k]) {
+      const Eigen::Vector3d x = frame.member_poses[k] * p.cast<double>();
+      keys.push_back(index(x.x()) << 42 | index(x.y()) << 21 | index(x.z()));
+    }
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    counts[k] = double(keys.size());
+    for (const auto key : keys) cells.emplace_back(key, static_cast<int>(k));
+  }
+  std::sort(cells.begin(), cells.end());
+  std::map<std::pair<int, int>, double> shared;
+  for (std::size_t begin = 0, end; begin < cells.size(); begin = end) {
+    for (end = begin; end < cells.size() && cells[end].first == cells[begin].first; ++end) {
+    }
+    for (std::size_t a = begin; a < end; ++a)
+      for (std::size_t b = a + 1; b < end; ++b) shared[{cells[a].second, cells[b].second}] += 1.0;
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const auto& [pair, n] : shared) {
+    const double w = n / std::sqrt(counts[pair.first] * counts[pair.second]);
+    const int a = frame.members[pair.first], b = frame.members[pair.second];
+    entries.emplace_back(a, b, w);
+    entries.emplace_back(b, a, w);
+  }
+  WeightMatrix overlap(size, size);
+  overlap.setFromTriplets(entries.begin(), entries.end());
+  return overlap;
+}
+
+/// Adds to `pairs` each member with up to `count` of its strongest partners
+/// in `by` (ties by position), pairs already `taken` left out.
+inline void addStrongestPartners(const std::vector<int>& members, const WeightMatrix& by, int count,
+                                 std::set<std::pair<int, int>>& taken, std::vector<std::pair<int, int>>& pairs) {
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    std::vector<std::pair<double, int>> overlapping;  // (-weight, member position): strongest first
+    for (WeightMatrix::InnerIterator it(by, members[k]); it; ++it) {
+      const auto found = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
+      if (found != members.end() && *found == it.row() && it.value() > 0 && *found != members[k])
+        overlapping.emplace_back(-it.value(), static_cast<int>(found - members.begin()));
+    }
+    std::sort(overlapping.begin(), overlapping.end());
+    const std::size_t n = std::min<std::size_t>(overlapping.size(), std::max(0, count));
+    for (std::size_t s = 0; s < n; ++s) {
+      const int a = static_cast<int>(k), b = overlapping[s].second;
+      const std::pair<int, int> pair(std::min(a, b), std::max(a, b));
+      if (taken.insert(pair).second) pairs.push_back(pair);
+    }
+  }
+}
+
 template <typename PointT>
 std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& observations) {
   std::vector<Eigen::Isometry3d> poses;
@@ -105,24 +167,14 @@ void LocalMapBuilder<PointT>::refine(const std::vector<Observation<PointT>>& obs
       pairs.emplace_back(parent, child);
       taken.emplace(std::min(parent, child), std::max(parent, child));
     }
+  const bool planar = detail::planar(observations, members);
   if (refinement_ == Refinement::Lum) {
-    for (std::size_t k = 0; k < members.size(); ++k) {
-      std::vector<std::pair<double, int>> overlapping;  // (-W, member position): strongest first, ties by position
-      for (WeightMatrix::InnerIterator it(W, members[k]); it; ++it) {
-        const auto found = std::lower_bound(members.begin(), members.end(), static_cast<int>(it.row()));
-        if (found != members.end() && *found == it.row() && it.value() > 0 && *found != members[k])
-          overlapping.emplace_back(-it.value(), static_cast<int>(found - members.begin()));
-      }
-      std::sort(overlapping.begin(), overlapping.end());
-      const std::size_t count = std::min<std::size_t>(overlapping.size(), std::max(0, parameters_.neighbours));
-      for (std::size_t s = 0; s < count; ++s) {
-        const int a = static_cast<int>(k), b = overlapping[s].second;
-        const std::pair<int, int> pair(std::min(a, b), std::max(a, b));
-        if (taken.insert(pair).second) pairs.push_back(pair);
-      }
-    }
+    detail::addStrongestPartners(members, W, parameters_.neighbours, taken, pairs);
+    if (planar && parameters_.point_neighbours > 0)
+      detail::addStrongestPartners(members, detail::pointOverlap(frame, points, parameters_.point_overlap_cell, W.rows()),
+                                   parameters_.point_neighbours, taken, pairs);
   }
-  map.refinement = refineMemberPoses(refinement_, points, pairs, detail::planar(observations, members), parameters_, frame);
+  map.refinement = refineMemberPoses(refinement_, points, pairs, planar, parameters_, frame);
 }
 
 template <typename PointT>
