@@ -189,3 +189,33 @@ TEST(Refinement, AnErrorInOneGroupNamesItInsteadOfEndingTheProcess) {
     EXPECT_NE(std::string(e.what()).find("local map 1"), std::string::npos) << e.what();
   }
 }
+
+TEST(Refinement, LumAlsoPairsPlanarScansWhosePointsShareSpace) {
+  // W joins each scan to the next only; the forward laser's scans along the
+  // corridor share walls with scans further away too.
+  Scene s = officeScene(sim::Sensor::Laser180, "corridor", 10);
+  std::vector<WeightedPair> chain;
+  for (int k = 1; k < 10; ++k) chain.push_back({k - 1, k, 1.0});
+  s.W = buildWeightMatrix(10, chain);
+  LocalMapBuilder<pcl::PointXYZ> builder;
+  builder.setRefinement(Refinement::Lum);
+  RefinementParameters by_w = builder.getRefinementParameters();
+  by_w.point_neighbours = 0;
+  builder.setRefinementParameters(by_w);
+  const auto w_only = builder.build(s.observations, everyone(10), s.W);
+  RefinementParameters with_points = by_w;
+  with_points.point_neighbours = 2;
+  builder.setRefinementParameters(with_points);
+  const auto both = builder.build(s.observations, everyone(10), s.W);
+  EXPECT_EQ(w_only.refinement.pairs, 9);  // the chain
+  EXPECT_GT(both.refinement.pairs, w_only.refinement.pairs);
+  // More pairs, still no harm to exact poses.
+  const auto [t, angle] = worstError(both.frame, s.truth);
+  EXPECT_LE(t, 0.01);
+  EXPECT_LE(angle, 0.5 * kDeg);
+  // Depth clouds are not planar: W's pairs alone.
+  Scene depth = officeScene(sim::Sensor::Depth, "room 2", 10);
+  depth.W = buildWeightMatrix(10, chain);
+  const auto depth_map = builder.build(depth.observations, everyone(10), depth.W);
+  EXPECT_EQ(depth_map.refinement.pairs, 9);
+}
