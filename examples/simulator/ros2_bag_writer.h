@@ -1,8 +1,9 @@
 #pragma once
-// Test helper: writes a ROS 2 bag in rosbag2's sqlite3 storage (a folder with
+// Writes a ROS 2 bag in rosbag2's sqlite3 storage (a folder with
 // metadata.yaml and .db3 files) from obsgroup's neutral message structs,
 // CDR-serialised with Fast CDR as rosbag2 does. Header only; needs SQLite and
-// Fast CDR (OBSGROUP_HAVE_ROS2).
+// Fast CDR (OBSGROUP_HAVE_ROS2). Used by the tests, make_datasets and the
+// bag benchmark.
 //
 //   obsgroup::test::Ros2BagWriter bag(dir / "bag");   // creates the folder
 //   bag.write("/scan", scan);                         // sensor_msgs/msg/LaserScan
