@@ -5,6 +5,7 @@
 #include "bag_messages.h"
 
 #include <obsgroup/io/errors.h>
+#include <obsgroup/io/pcd_sequence.h>
 
 #ifdef OBSGROUP_HAVE_ROS2
 #include <fastcdr/Cdr.h>
@@ -393,15 +394,6 @@ Metadata readMetadata(const fs::path& folder) {
   return metadata;
 }
 
-std::vector<std::string> db3Files(const fs::path& folder) {
-  std::vector<std::string> files;
-  std::error_code ec;
-  for (fs::directory_iterator entry(folder, ec), end; !ec && entry != end; entry.increment(ec))
-    if (entry->path().extension() == ".db3" && entry->is_regular_file(ec)) files.push_back(entry->path().string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 /// The bag's .db3 files, in the order metadata.yaml lists them (time order).
 std::vector<std::string> bagFiles(const std::string& folder) {
   const fs::path path(folder);
@@ -423,7 +415,7 @@ std::vector<std::string> bagFiles(const std::string& folder) {
     const fs::path listed = path / name;
     files.push_back(fs::exists(listed, ec) ? listed.string() : (path / fs::path(name).filename()).string());
   }
-  if (files.empty()) files = db3Files(path);
+  if (files.empty()) files = filesWithExtension(path.string(), ".db3");  // natural order: bag_2 before bag_10
   if (files.empty())
     throw InputError(folder + (metadata.found ? ": metadata.yaml lists no file and the folder has no .db3 file"
                                               : ": no metadata.yaml and no .db3 file: not a ROS 2 bag"));
