@@ -7,14 +7,8 @@
 #include <obsgroup/io/ros_bag.h>
 
 #include "bag_messages.h"
-#ifdef OBSGROUP_HAVE_ROS1
-#include <rosbag/bag.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
-#endif
-#ifdef OBSGROUP_HAVE_ROS2
+#include "ros1_bag_writer.h"
 #include "ros2_bag_writer.h"
-#endif
 
 #include <algorithm>
 #include <chrono>
@@ -49,46 +43,9 @@ bag::Scan scan(double stamp, int k) {
   return s;
 }
 
-#ifdef OBSGROUP_HAVE_ROS1
-geometry_msgs::TransformStamped ros1(const bag::Transform& t) {
-  geometry_msgs::TransformStamped m;
-  m.header.frame_id = t.header.frame_id;
-  m.header.stamp = ros::Time(t.header.stamp);
-  m.child_frame_id = t.child_frame_id;
-  const Eigen::Quaterniond q(t.transform.rotation());
-  m.transform.translation.x = t.transform.translation().x();
-  m.transform.rotation.z = q.z();
-  m.transform.rotation.w = q.w();
-  return m;
-}
-
-void writeRos1(const std::string& path, int n) {
-  rosbag::Bag out(path, rosbag::bagmode::Write);
-  tf2_msgs::TFMessage mount;
-  mount.transforms.push_back(ros1(transform("base_link", "laser", 100, 0.2, 0)));
-  out.write("/tf_static", ros::Time(100), mount);
-  for (int k = 0; k < n; ++k) {
-    const double t = 100 + 0.05 * k;
-    tf2_msgs::TFMessage tf;
-    tf.transforms = {ros1(transform("map", "odom", t, 1, 0)), ros1(transform("odom", "base_link", t, 0.1 * k, 0.01 * k))};
-    out.write("/tf", ros::Time(t), tf);
-    const bag::Scan s = scan(t, k);
-    sensor_msgs::LaserScan m;
-    m.header.frame_id = s.header.frame_id;
-    m.header.stamp = ros::Time(t);
-    m.angle_min = float(s.angle_min);
-    m.angle_increment = float(s.angle_increment);
-    m.range_min = float(s.range_min);
-    m.range_max = float(s.range_max);
-    m.ranges = s.ranges;
-    out.write("/scan", ros::Time(t), m);
-  }
-}
-#endif
-
-#ifdef OBSGROUP_HAVE_ROS2
-void writeRos2(const std::string& folder, int n) {
-  obsgroup::test::Ros2BagWriter out(folder);
+/// The bag, of either kind (Ros1BagWriter or Ros2BagWriter).
+template <typename Writer>
+void writeBag(Writer&& out, int n) {
   out.writeTf("/tf_static", {transform("base_link", "laser", 100, 0.2, 0)});
   for (int k = 0; k < n; ++k) {
     const double t = 100 + 0.05 * k;
@@ -97,7 +54,6 @@ void writeRos2(const std::string& folder, int n) {
   }
   out.close();
 }
-#endif
 
 }  // namespace
 
@@ -118,10 +74,10 @@ int main(int argc, char** argv) {
   const std::string path = (fs::path(argv[2]) / (ros1 ? "bench.bag" : "bench_ros2")).string();
   fs::remove_all(path);
 #ifdef OBSGROUP_HAVE_ROS1
-  if (ros1) writeRos1(path, n);
+  if (ros1) writeBag(obsgroup::test::Ros1BagWriter(path), n);
 #endif
 #ifdef OBSGROUP_HAVE_ROS2
-  if (!ros1) writeRos2(path, n);
+  if (!ros1) writeBag(obsgroup::test::Ros2BagWriter(path), n);
 #endif
   std::vector<double> seconds;
   std::size_t observations = 0;

@@ -26,14 +26,8 @@
 #include "to_cloud.h"
 
 #include "bag_messages.h"
-#ifdef OBSGROUP_HAVE_ROS1
-#include <rosbag/bag.h>
-#include <sensor_msgs/LaserScan.h>
-#include <tf2_msgs/TFMessage.h>
-#endif
-#ifdef OBSGROUP_HAVE_ROS2
+#include "ros1_bag_writer.h"
 #include "ros2_bag_writer.h"
-#endif
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -210,75 +204,31 @@ BagRun office2DBagRun() {
   return run;
 }
 
-#ifdef OBSGROUP_HAVE_ROS1
-geometry_msgs::TransformStamped ros1Transform(const bag::Transform& t) {
-  geometry_msgs::TransformStamped m;
-  m.header.frame_id = t.header.frame_id;
-  m.header.stamp = ros::Time(t.header.stamp);
-  m.child_frame_id = t.child_frame_id;
-  const Eigen::Vector3d p = t.transform.translation();
-  const Eigen::Quaterniond q(t.transform.rotation());
-  m.transform.translation.x = p.x();
-  m.transform.translation.y = p.y();
-  m.transform.translation.z = p.z();
-  m.transform.rotation.x = q.x();
-  m.transform.rotation.y = q.y();
-  m.transform.rotation.z = q.z();
-  m.transform.rotation.w = q.w();
-  return m;
-}
-
-int writeOffice2DRos1(const std::string& path) {
+/// The office_2d run into a bag of either kind (Ros1BagWriter or Ros2BagWriter).
+template <typename Writer>
+int writeOffice2D(Writer&& out, const std::string& path) {
   const BagRun run = office2DBagRun();
-  rosbag::Bag out(path, rosbag::bagmode::Write);
-  tf2_msgs::TFMessage mount;
-  mount.transforms.push_back(ros1Transform(run.mount));
-  out.write("/tf_static", ros::Time(run.mount.header.stamp), mount);
-  for (std::size_t k = 0; k < run.scans.size(); ++k) {
-    const bag::Scan& s = run.scans[k];
-    tf2_msgs::TFMessage tf;
-    for (const auto& t : run.tf[k]) tf.transforms.push_back(ros1Transform(t));
-    out.write("/tf", ros::Time(s.header.stamp), tf);
-    sensor_msgs::LaserScan scan;
-    scan.header.frame_id = s.header.frame_id;
-    scan.header.stamp = ros::Time(s.header.stamp);
-    scan.angle_min = float(s.angle_min);
-    scan.angle_max = float(s.angle_min + s.angle_increment * double(s.ranges.size() - 1));
-    scan.angle_increment = float(s.angle_increment);
-    scan.range_min = float(s.range_min);
-    scan.range_max = float(s.range_max);
-    scan.ranges = s.ranges;
-    out.write("/scan", scan.header.stamp, scan);
-  }
-  std::printf("wrote %s\n", path.c_str());
-  return 0;
-}
-#endif
-
-#ifdef OBSGROUP_HAVE_ROS2
-int writeOffice2DRos2(const std::string& folder) {
-  const BagRun run = office2DBagRun();
-  obsgroup::test::Ros2BagWriter out(folder);
   out.writeTf("/tf_static", {run.mount});
   for (std::size_t k = 0; k < run.scans.size(); ++k) {
     out.writeTf("/tf", run.tf[k]);
     out.write("/scan", run.scans[k]);
   }
   out.close();
-  std::printf("wrote %s\n", folder.c_str());
+  std::printf("wrote %s\n", path.c_str());
   return 0;
 }
-#endif
 
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--tum-rgbd") return writeOffice3DTum(argv[2]);
 #ifdef OBSGROUP_HAVE_ROS1
-  if (argc == 3 && std::string(argv[1]) == "--ros1-bag") return writeOffice2DRos1(argv[2]);
+  if (argc == 3 && std::string(argv[1]) == "--ros1-bag")
+    return writeOffice2D(obsgroup::test::Ros1BagWriter(argv[2]), argv[2]);
 #endif
 #ifdef OBSGROUP_HAVE_ROS2
-  if (argc == 3 && std::string(argv[1]) == "--ros2-bag") return writeOffice2DRos2(argv[2]);
+  if (argc == 3 && std::string(argv[1]) == "--ros2-bag")
+    return writeOffice2D(obsgroup::test::Ros2BagWriter(argv[2]), argv[2]);
 #endif
   if (argc < 2 || argc > 3 || (argc == 3 && std::string(argv[2]) != "--force")) {
     std::cerr << "usage: " << argv[0] << " OUTDIR [--force] | --tum-rgbd FOLDER | --ros1-bag FILE | --ros2-bag FOLDER\n";

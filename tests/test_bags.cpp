@@ -107,6 +107,24 @@ sensor_msgs::LaserScan scanMessage(const std::string& frame, double stamp) {
   return scan;
 }
 
+/// An empty cloud whose points are the FLOAT32 `fields`, packed in order
+/// (point_step set; height, width, row_step and data left to the caller).
+sensor_msgs::PointCloud2 floatCloud(const std::string& frame, double stamp, std::vector<std::string> fields) {
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = frame;
+  cloud.header.stamp = rosTime(stamp);
+  for (const std::string& name : fields) {
+    sensor_msgs::PointField f;
+    f.name = name;
+    f.offset = std::uint32_t(4 * cloud.fields.size());
+    f.datatype = sensor_msgs::PointField::FLOAT32;
+    f.count = 1;
+    cloud.fields.push_back(f);
+  }
+  cloud.point_step = std::uint32_t(4 * fields.size());
+  return cloud;
+}
+
 /// The laser 0.2 m ahead of base_link; base_link moves in odom from (0,0)
 /// at t=10 to (2,0) facing left at t=12; odom sits at (100, 0) in map.
 class Ros1Bag : public obsgroup::test::TempFolderTest {
@@ -258,20 +276,9 @@ TEST_F(Ros1Bag, PointCloudsKeepTheirFiniteXyzAcrossPaddedRows) {
     tf2_msgs::TFMessage tf;
     tf.transforms.push_back(transformMessage("map", "camera", 5, planar(1, 2, 0)));
     bag.write("/tf", rosTime(5), tf);
-    sensor_msgs::PointCloud2 cloud;
-    cloud.header.frame_id = "camera";
-    cloud.header.stamp = rosTime(5);
+    sensor_msgs::PointCloud2 cloud = floatCloud("camera", 5, {"x", "y", "z", "intensity"});
     cloud.height = 2;
     cloud.width = 2;
-    for (const char* axis : {"x", "y", "z", "intensity"}) {
-      sensor_msgs::PointField f;
-      f.name = axis;
-      f.offset = std::uint32_t(4 * cloud.fields.size());
-      f.datatype = sensor_msgs::PointField::FLOAT32;
-      f.count = 1;
-      cloud.fields.push_back(f);
-    }
-    cloud.point_step = 16;
     cloud.row_step = 40;  // 8 bytes of padding per row
     cloud.data.assign(cloud.row_step * cloud.height, 0);
     const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -308,20 +315,10 @@ TEST_F(Ros1Bag, CloudsInAnOpticalFrameAreTurnedIntoTheBodyFrame) {
     optical.translation() << 0, 0, 1;
     tf.transforms.push_back(transformMessage("map", "camera_depth_optical_frame", 5, optical));
     bag.write("/tf", rosTime(5), tf);
-    sensor_msgs::PointCloud2 cloud;
-    cloud.header.frame_id = "camera_depth_optical_frame";
-    cloud.header.stamp = rosTime(5);
+    sensor_msgs::PointCloud2 cloud = floatCloud("camera_depth_optical_frame", 5, {"x", "y", "z"});
     cloud.height = 1;
     cloud.width = 1;
-    for (const char* axis : {"x", "y", "z"}) {
-      sensor_msgs::PointField f;
-      f.name = axis;
-      f.offset = std::uint32_t(4 * cloud.fields.size());
-      f.datatype = sensor_msgs::PointField::FLOAT32;
-      f.count = 1;
-      cloud.fields.push_back(f);
-    }
-    cloud.point_step = cloud.row_step = 12;
+    cloud.row_step = 12;
     const float point[3] = {0.5f, -0.25f, 2.0f};  // right 0.5, up 0.25, 2 m ahead
     cloud.data.resize(12);
     std::memcpy(cloud.data.data(), point, 12);
@@ -378,16 +375,9 @@ TEST(Ros1Message, ALengthBeyondTheDataIsRefusedBeforeAllocating) {
 }
 
 TEST(Ros1Message, ACloudWhoseDataDoNotFitItsRowsIsRefused) {
-  sensor_msgs::PointCloud2 cloud;
-  cloud.header.frame_id = "c";
+  sensor_msgs::PointCloud2 cloud = floatCloud("c", 0, {"x"});
   cloud.height = 1;
   cloud.width = 10;
-  sensor_msgs::PointField f;
-  f.name = "x";
-  f.datatype = sensor_msgs::PointField::FLOAT32;
-  f.count = 1;
-  cloud.fields = {f};
-  cloud.point_step = 4;
   cloud.row_step = 40;
   cloud.data.assign(36, 0);
   bag::Messages into;
