@@ -464,6 +464,19 @@ TEST_F(Ros1Bag, ATumTrajectoryPosesTheMessagesByTimestamp) {
   EXPECT_EQ(loadBag(path(), BagVersion::Ros1, options).observations.size(), 4u);
   options.pose_topic = "/odom";
   EXPECT_THROW(loadBag(path(), BagVersion::Ros1, options), UsageError);
+  // The trajectory gives the poses: /tf is not even read (here it could not be).
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "laser", 10, planar(0, 0, 0)));
+    tf.transforms[0].transform.rotation.w = 0;
+    bag.write("/tf", rosTime(10), tf);
+    bag.write("/scan", rosTime(10), scanMessage("laser", 10));
+  }
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1); }, {"on /tf", "is no rotation"}));
+  BagOptions trajectory_only;
+  trajectory_only.poses_file = (dir_ / "trajectory.txt").string();
+  EXPECT_EQ(loadBag(path(), BagVersion::Ros1, trajectory_only).observations.size(), 1u);
 }
 
 TEST_F(Ros1Bag, AFileThatIsNotABagIsAnInputError) {

@@ -82,11 +82,12 @@ struct Numbered {
 };
 
 /// What to decode. The data topic is a LaserScan or PointCloud2 topic (its
-/// type says which); /tf and /tf_static are read when present; the pose
-/// topic, if any, is an Odometry or PoseStamped topic.
+/// type says which); /tf and /tf_static are read when present (and asked);
+/// the pose topic, if any, is an Odometry or PoseStamped topic.
 struct Request {
   std::string data_topic;
   std::optional<std::string> pose_topic;
+  bool tf = true;  ///< false when the poses come from elsewhere (a trajectory file): /tf is not read
 };
 
 struct Messages {

@@ -533,7 +533,7 @@ BagReader::BagReader(const std::string& path, BagVersion version, const BagOptio
   c.topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
   c.data = chooseDataTopic(c.topics, options.topic, path);
   if (options.pose_topic) checkPoseTopic(c.topics, *options.pose_topic, path);
-  const bag::Request request{c.data.name, options.pose_topic};
+  const bag::Request request{c.data.name, options.pose_topic, !options.poses_file};
   c.messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
 }
 

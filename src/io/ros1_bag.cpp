@@ -261,7 +261,7 @@ Messages readRos1Messages(const std::string& path, const Request& request) {
     std::vector<std::string> present;
     for (const rosbag::ConnectionInfo* c : rosbag::View(bag).getConnections()) present.push_back(c->topic);
     for (const char* tf : {"/tf", "/tf_static"})
-      if (std::find(present.begin(), present.end(), tf) != present.end() && !roles.count(tf))
+      if (request.tf && std::find(present.begin(), present.end(), tf) != present.end() && !roles.count(tf))
         roles[tf] = std::string(tf) == "/tf" ? Role::Tf : Role::TfStatic;
     std::vector<std::string> asked;
     for (const auto& [topic, role] : roles) asked.push_back(topic);

@@ -567,6 +567,7 @@ Messages readRos2Messages(const std::string& folder, const Request& request) {
   Messages messages;
   readTopic(bag, required(request.data_topic), Role::Data, messages);
   if (request.pose_topic) readTopic(bag, required(*request.pose_topic), Role::Pose, messages);
+  if (!request.tf) return messages;
   if (const Topic* tf = findTopic(bag, "/tf")) readTopic(bag, *tf, Role::Tf, messages);
   if (const Topic* tf_static = findTopic(bag, "/tf_static")) readTopic(bag, *tf_static, Role::TfStatic, messages);
   return messages;
