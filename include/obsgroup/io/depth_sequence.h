@@ -1,5 +1,5 @@
 #pragma once
-// Depth image sequences (16-bit PNG) as clouds in the camera frame: the TUM
+// Depth image sequences (16-bit PNG) as clouds in the camera body frame: the TUM
 // RGB-D layout (depth.txt, depth/, groundtruth.txt matched by timestamp) and
 // the Redwood/Open3D layout (depth/*.png, trajectory.log).
 //
