@@ -2,11 +2,11 @@
 
 #include "obsgroup/common/parallel_for.h"
 
-#include <Eigen/OrderingMethods>
-
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace obsgroup {
 
@@ -41,39 +41,72 @@ struct Decision {
   std::vector<std::vector<int>> children;
   int child_depth = 0;
   std::string warning;  // empty, or what the user should know about this node
+  bool from_cache = false;  // copied from SplitCache
 };
 
-/// Each node's rank in one fill-reducing elimination order of the whole
-/// graph (AMD's, or the user's), or nothing when no sparse solve can happen.
-/// Restricted to a subgraph it keeps a low fill: a subgraph of a route is a
-/// stretch of it, eliminated in the order of the whole. One ordering serves
-/// every node of the split tree (an AMD ordering of its own cost a subgraph
-/// more than its numeric factorisation).
-std::vector<int> eliminationRanks(const WeightMatrix& W, const FiedlerOptions& eigen) {
-  const Eigen::Index n = W.rows();
-  if (!eigen.elimination_rank.empty()) {
-    if (Eigen::Index(eigen.elimination_rank.size()) != n)
-      throw std::invalid_argument("recursivePartition: elimination_rank needs one rank per observation");
-    return eigen.elimination_rank;
+/// A node's members (by stable id) and depth as a hash key.
+std::uint64_t nodeKey(const std::vector<int>& member_ids, int depth) {
+  std::uint64_t h = 1469598103934665603ull ^ std::uint64_t(depth);
+  for (int id : member_ids) h = (h ^ std::uint64_t(std::uint32_t(id))) * 1099511628211ull;
+  return h ^ (std::uint64_t(member_ids.size()) << 32);
+}
+
+/// What the partitioner reuses and records: the ids of W's nodes, which
+/// rows changed, and the decisions of the previous and of this run.
+struct Reuse {
+  const std::vector<int>& ids;
+  const std::vector<char>& changed;
+  const SplitCache::Store& previous;
+  SplitCache::Store& next;
+};
+
+}  // namespace
+
+/// A decision with its members and children given by stable id.
+struct SplitCache::Store {
+  struct Entry {
+    std::vector<int> member_ids;
+    int depth = 0;
+    Decision decision;  // children by id
+  };
+  std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
+  std::size_t reused = 0, computed = 0;
+
+  const Entry* find(const std::vector<int>& member_ids, int depth) const {
+    const auto it = entries.find(nodeKey(member_ids, depth));
+    if (it == entries.end()) return nullptr;
+    for (const Entry& e : it->second)
+      if (e.depth == depth && e.member_ids == member_ids) return &e;
+    return nullptr;
   }
-  if (eigen.solver == EigenSolver::Dense || (eigen.solver == EigenSolver::Auto && n <= eigen.dense_max_size))
-    return {};
-  // The pattern of the Laplacian: Eigen's AMD needs the diagonal entries
-  // (without them it returns the identity).
-  WeightMatrix identity(n, n);
-  identity.setIdentity();
-  const WeightMatrix pattern = W + identity;
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order;  // order[k]: the node eliminated k-th
-  Eigen::AMDOrdering<int>()(pattern, order);
-  std::vector<int> rank(n);
-  for (Eigen::Index k = 0; k < n; ++k) rank[order.indices()[k]] = static_cast<int>(k);
-  return rank;
+  void add(std::vector<int> member_ids, int depth, Decision decision) {
+    const std::uint64_t key = nodeKey(member_ids, depth);
+    entries[key].push_back({std::move(member_ids), depth, std::move(decision)});
+  }
+};
+
+SplitCache::SplitCache() : store_(std::make_shared<Store>()) {}
+void SplitCache::clear() { *store_ = Store{}; }
+std::size_t SplitCache::reusedNodes() const { return store_->reused; }
+std::size_t SplitCache::computedNodes() const { return store_->computed; }
+
+namespace {
+
+/// The elimination ranks the user gave for the whole graph, or none: then
+/// each node's Fiedler solve orders its own block (AMD), so that a node's
+/// decision depends on its block of W alone (SplitCache relies on it).
+/// Measured on 10,000-scan route graphs: see docs/performance.md.
+std::vector<int> eliminationRanks(const WeightMatrix& W, const FiedlerOptions& eigen) {
+  if (eigen.elimination_rank.empty()) return {};
+  if (Eigen::Index(eigen.elimination_rank.size()) != W.rows())
+    throw std::invalid_argument("recursivePartition: elimination_rank needs one rank per observation");
+  return eigen.elimination_rank;
 }
 
 class Partitioner {
  public:
-  Partitioner(const WeightMatrix& W, const PartitionOptions& options)
-      : W_(W), options_(options), rank_(eliminationRanks(W, options.eigen)) {}
+  Partitioner(const WeightMatrix& W, const PartitionOptions& options, Reuse* reuse = nullptr)
+      : W_(W), options_(options), rank_(eliminationRanks(W, options.eigen)), reuse_(reuse) {}
 
   Partition run() {
     const int n = static_cast<int>(W_.rows());
@@ -96,11 +129,15 @@ class Partitioner {
       // node's exception is rethrown unchanged (an input error stays one).
       parallelForWithScratch(
           frontier.size(), options_.threads, 1, [n] { return std::vector<int>(n, -1); },
-          [&](std::size_t k, std::vector<int>& local_of) { decisions[k] = decide(out_.splits[frontier[k]], local_of); });
+          [&](std::size_t k, std::vector<int>& local_of) {
+            if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k]))
+              decisions[k] = decide(out_.splits[frontier[k]], local_of);
+          });
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];
         Decision& d = decisions[k];
+        if (reuse_) record(out_.splits[id], d);
         if (!d.warning.empty()) out_.warnings.push_back(std::move(d.warning));
         d.node.members = std::move(out_.splits[id].members);
         d.node.parent = out_.splits[id].parent;
@@ -122,6 +159,37 @@ class Partitioner {
   }
 
  private:
+  std::vector<int> idsOf(const std::vector<int>& members) const {
+    std::vector<int> ids(members.size());
+    for (std::size_t k = 0; k < members.size(); ++k) ids[k] = reuse_->ids[members[k]];
+    return ids;
+  }
+
+  /// The previous run's decision of this node, when none of its members'
+  /// rows changed: its block of W, hence its decision, is the same.
+  bool copyCachedDecision(const SplitNode& current, Decision& d) const {
+    if (!reuse_) return false;
+    for (int i : current.members)
+      if (reuse_->changed[i]) return false;
+    const auto* entry = reuse_->previous.find(idsOf(current.members), current.depth);
+    if (!entry) return false;
+    d = entry->decision;
+    for (auto& child : d.children)
+      for (int& member : child)
+        member = int(std::lower_bound(reuse_->ids.begin(), reuse_->ids.end(), member) - reuse_->ids.begin());
+    d.from_cache = true;
+    return true;
+  }
+
+  /// Keeps this node's decision, by ids, for the next run.
+  void record(const SplitNode& current, const Decision& d) {
+    Decision kept = d;
+    kept.from_cache = false;
+    for (auto& child : kept.children) child = idsOf(child);
+    reuse_->next.add(idsOf(current.members), current.depth, std::move(kept));
+    ++(d.from_cache ? reuse_->next.reused : reuse_->next.computed);
+  }
+
   Decision decide(const SplitNode& current, std::vector<int>& local_of) const {
     Decision d;
     const std::vector<int>& members = current.members;
@@ -225,6 +293,7 @@ class Partitioner {
   const WeightMatrix& W_;
   const PartitionOptions& options_;
   const std::vector<int> rank_;  // see eliminationRanks
+  Reuse* reuse_;
   Partition out_;
 };
 
@@ -257,6 +326,25 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
   checkWeights(W);
   return Partitioner(W, options).run();
+}
+
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
+                             const std::vector<char>& changed, SplitCache& cache) {
+  if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
+  if (!(options.ncut_threshold >= 0.0))
+    throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
+  if (!options.eigen.elimination_rank.empty())
+    throw std::invalid_argument("recursivePartition: a split cache needs each node to order itself (no elimination_rank)");
+  if (Eigen::Index(ids.size()) != W.rows() || Eigen::Index(changed.size()) != W.rows())
+    throw std::invalid_argument("recursivePartition: one id and one changed flag per node expected");
+  if (!std::is_sorted(ids.begin(), ids.end()) || std::adjacent_find(ids.begin(), ids.end()) != ids.end())
+    throw std::invalid_argument("recursivePartition: node ids must ascend");
+  checkWeights(W);
+  auto next = std::make_shared<SplitCache::Store>();
+  Reuse reuse{ids, changed, *cache.store_, *next};
+  Partition partition = Partitioner(W, options, &reuse).run();
+  cache.store_ = std::move(next);  // only when the run succeeded: an error leaves the cache as it was
+  return partition;
 }
 
 }  // namespace obsgroup

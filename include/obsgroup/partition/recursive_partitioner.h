@@ -7,7 +7,9 @@
 #include "obsgroup/common/interrupt.h"
 #include "obsgroup/spectral/spectral_bisection.h"
 
+#include <cstddef>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -86,5 +88,39 @@ struct Partition {
 /// Throws std::invalid_argument when W is not square, symmetric, finite and
 /// non-negative, and Interrupted when options.interrupt is set.
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options = {});
+
+/// The decisions of the split tree of one recursivePartition, kept for the
+/// next on a graph that differs in the rows of a few nodes (online grouping:
+/// observations inserted, moved or removed). A node's decision depends only
+/// on its members' block of W, its depth and the options (each node orders
+/// its own elimination, see FiedlerOptions::elimination_rank), so a node with
+/// the same members, at the same depth, none of whose rows changed, is
+/// decided as before: its decision is copied, bit for bit, instead of solved.
+/// The result is then the one recursivePartition gives from scratch.
+class SplitCache {
+ public:
+  SplitCache();
+  /// Forgets every decision (e.g. after the options changed).
+  void clear();
+  /// Nodes of the last run whose decision was copied / computed.
+  std::size_t reusedNodes() const;
+  std::size_t computedNodes() const;
+
+  struct Store;  ///< opaque
+
+ private:
+  friend Partition recursivePartition(const WeightMatrix&, const PartitionOptions&, const std::vector<int>&,
+                                      const std::vector<char>&, SplitCache&);
+  std::shared_ptr<Store> store_;
+};
+
+/// recursivePartition reusing `cache`'s decisions, then leaving this run's in
+/// it. Node k of W has the stable id ids[k] (ascending: the ids of the run
+/// that filled the cache keep their order), and changed[k] != 0 when its row
+/// of W may differ from that run's. The options must be those of that run
+/// (the cache does not check them; clear it when they change), and
+/// options.eigen.elimination_rank must be empty.
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
+                             const std::vector<char>& changed, SplitCache& cache);
 
 }  // namespace obsgroup

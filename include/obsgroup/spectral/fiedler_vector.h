@@ -38,11 +38,13 @@ struct FiedlerOptions {
   /// memory grows as N^2: 200 MB at 5,000 nodes).
   int dense_fallback_max_size = 5000;
   /// Optional elimination order for the sparse factorisation: one rank per
-  /// node, eliminated in increasing rank (ties by index). Empty: an AMD
-  /// ordering is computed. recursivePartition computes one fill-reducing
-  /// order of the whole graph and hands each subgraph its members' ranks, so
-  /// no subgraph needs an ordering of its own (given here for the whole
-  /// graph, it is used instead of AMD's). Only speed depends on it.
+  /// node, eliminated in increasing rank (ties by index). Empty (the
+  /// default): an AMD ordering of this graph is computed. recursivePartition
+  /// leaves it empty, so each node of the split tree is ordered from its own
+  /// block of W alone and decided the same whatever the rest of the graph
+  /// (what lets online grouping reuse decisions, see SplitCache); given for
+  /// the whole graph, each node gets its members' ranks instead. Only speed
+  /// depends on it, and the last bits of the eigenvector.
   std::vector<int> elimination_rank{};
 };
 

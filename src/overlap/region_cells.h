@@ -1,0 +1,444 @@
+#pragma once
+// The cell machinery of the region models (sensed_regions.h), shared by the
+// batch computation (sensed_regions.cpp) and the incremental one
+// (incremental_overlap.cpp), so that both compute each observation's region
+// with the same code and get the same cells. Internal: not installed.
+
+#include "obsgroup/overlap/sensed_regions.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <iterator>
+#include <limits>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace obsgroup {
+namespace region_cells {
+
+/// One observation's points in the re-centred frame.
+struct PointSpan {
+  const Eigen::Vector3f* begin = nullptr;
+  const Eigen::Vector3f* end = nullptr;
+  bool empty() const { return begin == end; }
+  std::size_t size() const { return std::size_t(end - begin); }
+};
+
+inline PointSpan pointsOf(const WorldPoints& world, int i) { return {world.begin(i), world.end(i)}; }
+
+// --- cells and keys ---------------------------------------------------------
+//
+// A cell is (ix, iy) in 2D or (ix, iy, iz) in 3D, ix = floor(x / cell_size)
+// of the re-centred coordinates. Its key packs the biased indices so that
+// keys ascend in lexicographic (x, y, z) order: 32 bits per axis in 2D, 21 in 3D.
+
+constexpr std::int64_t kBias2 = std::int64_t(1) << 31;
+constexpr std::int64_t kBias3 = std::int64_t(1) << 20;
+
+template <int D>
+using Cell = std::array<std::int64_t, D>;
+
+template <int D>
+std::uint64_t keyOf(const Cell<D>& c) {
+  if constexpr (D == 2) return (std::uint64_t(c[0] + kBias2) << 32) | std::uint64_t(c[1] + kBias2);
+  else return (std::uint64_t(c[0] + kBias3) << 42) | (std::uint64_t(c[1] + kBias3) << 21) | std::uint64_t(c[2] + kBias3);
+}
+
+template <int D>
+void checkRepresentable(const Cell<D>& lo, const Cell<D>& hi) {
+  const std::int64_t limit = (D == 2 ? kBias2 : kBias3) - 2;
+  for (int a = 0; a < D; ++a)
+    if (lo[a] < -limit || hi[a] > limit)
+      throw std::invalid_argument("the map spans more cells than a region can index: raise the cell size");
+}
+
+/// The cells one observation's region covers, marked in a bitmap over its
+/// bounding box (in cells) and read back in key order; a box too large for a
+/// bitmap falls back to collecting and sorting the keys.
+template <int D>
+class RegionMarker {
+ public:
+  void reset(const Cell<D>& lo, const Cell<D>& hi) {
+    lo_ = lo;
+    std::uint64_t total = 1;
+    for (int a = 0; a < D; ++a) {
+      extent_[a] = hi[a] - lo[a] + 1;
+      total *= std::uint64_t(extent_[a]);
+    }
+    dense_ = total <= (std::uint64_t(1) << 26);
+    keys_.clear();
+    removed_.clear();
+    if (dense_) bits_.assign((total + 63) / 64, 0);
+  }
+  void mark(const Cell<D>& c) {
+    if (!dense_) {
+      keys_.push_back(keyOf<D>(c));
+      return;
+    }
+    const std::uint64_t b = offset(c);
+    bits_[b >> 6] |= std::uint64_t(1) << (b & 63);
+  }
+  /// Clears a cell of the box (dense bitmaps; the sparse fallback drops it
+  /// when emitting). Cells outside the box are ignored.
+  void unmark(const Cell<D>& c) {
+    for (int a = 0; a < D; ++a)
+      if (c[a] < lo_[a] || c[a] >= lo_[a] + extent_[a]) return;
+    if (!dense_) {
+      removed_.push_back(keyOf<D>(c));
+      return;
+    }
+    const std::uint64_t b = offset(c);
+    bits_[b >> 6] &= ~(std::uint64_t(1) << (b & 63));
+  }
+  /// Whether a cell is marked (cells outside the box are not).
+  bool marked(const Cell<D>& c) const {
+    for (int a = 0; a < D; ++a)
+      if (c[a] < lo_[a] || c[a] >= lo_[a] + extent_[a]) return false;
+    if (!dense_) return std::find(keys_.begin(), keys_.end(), keyOf<D>(c)) != keys_.end();
+    const std::uint64_t b = offset(c);
+    return bits_[b >> 6] >> (b & 63) & 1;
+  }
+  /// Appends the marked keys, ascending.
+  void emit(std::vector<std::uint64_t>& out) {
+    if (!dense_) {
+      std::sort(keys_.begin(), keys_.end());
+      keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
+      std::sort(removed_.begin(), removed_.end());
+      std::set_difference(keys_.begin(), keys_.end(), removed_.begin(), removed_.end(), std::back_inserter(out));
+      return;
+    }
+    for (std::size_t w = 0; w < bits_.size(); ++w)
+      for (std::uint64_t word = bits_[w]; word; word &= word - 1) {
+        std::uint64_t b = w * 64 + std::uint64_t(__builtin_ctzll(word));
+        Cell<D> c;
+        for (int a = D - 1; a >= 0; --a) {
+          c[a] = lo_[a] + std::int64_t(b % std::uint64_t(extent_[a]));
+          b /= std::uint64_t(extent_[a]);
+        }
+        out.push_back(keyOf<D>(c));
+      }
+  }
+
+ private:
+  std::uint64_t offset(const Cell<D>& c) const {
+    std::uint64_t b = 0;
+    for (int a = 0; a < D; ++a) b = b * std::uint64_t(extent_[a]) + std::uint64_t(c[a] - lo_[a]);
+    return b;
+  }
+  Cell<D> lo_{};
+  std::array<std::int64_t, D> extent_{};
+  bool dense_ = true;
+  std::vector<std::uint64_t> bits_;
+  std::vector<std::uint64_t> keys_, removed_;
+};
+
+/// Visits the cells a segment from `from` to `to` (in cell units) crosses, in
+/// order (Amanatides and Woo). `visit(cell, t)` gets the parameter t in [0, 1]
+/// at which the segment enters the cell and returns false to stop.
+template <int D, typename Visit>
+void traverse(const std::array<double, D>& from, const std::array<double, D>& to, Visit&& visit) {
+  Cell<D> cell, last;
+  std::array<double, D> next, step_t;
+  std::array<int, D> step;
+  std::int64_t budget = 1;
+  for (int a = 0; a < D; ++a) {
+    cell[a] = std::int64_t(std::floor(from[a]));
+    last[a] = std::int64_t(std::floor(to[a]));
+    const double d = to[a] - from[a];
+    step[a] = d > 0 ? 1 : -1;
+    step_t[a] = d != 0 ? 1.0 / std::abs(d) : std::numeric_limits<double>::infinity();
+    next[a] = d != 0 ? (double(cell[a] + (d > 0)) - from[a]) / d : std::numeric_limits<double>::infinity();
+    budget += std::abs(last[a] - cell[a]);
+  }
+  double t = 0.0;
+  // The budget (the cells between the end cells) bounds the walk whatever
+  // the rounding of `next`.
+  for (std::int64_t k = 0; k < budget; ++k) {
+    if (!visit(cell, t) || cell == last) return;
+    int axis = 0;
+    for (int a = 1; a < D; ++a)
+      if (next[a] < next[axis]) axis = a;
+    if (next[axis] > 1.0) return;
+    t = next[axis];
+    cell[axis] += step[axis];
+    next[axis] += step_t[axis];
+  }
+}
+
+/// The cell grid, anchored on the first observation (the origin of the
+/// re-centred frame) so that a map at UTM coordinates has the same cells as
+/// the same map near 0. The first sensor sits at a cell's centre, not on its
+/// corner: routes that keep one coordinate (a corridor's axis) then do not
+/// run along cell edges, where rounding would pick the side.
+struct CellGrid {
+  explicit CellGrid(double cell_size) : size(cell_size) {}
+  /// Re-centred coordinates in cells.
+  template <int D>
+  std::array<double, D> inCells(const Eigen::Vector3d& p) const {
+    std::array<double, D> out;
+    for (int a = 0; a < D; ++a) out[a] = p[a] / size + phase[a];
+    return out;
+  }
+  double size;
+  std::array<double, 3> phase{0.5, 0.5, 0.5};
+};
+
+template <int D>
+Cell<D> cellOf(const std::array<double, D>& p) {
+  Cell<D> c;
+  for (int a = 0; a < D; ++a) c[a] = std::int64_t(std::floor(p[a]));
+  return c;
+}
+
+/// The box of cells within `range` of `origin` (both in cell units), one
+/// cell of margin for rounding.
+template <int D>
+std::pair<Cell<D>, Cell<D>> boxAround(const std::array<double, D>& origin, double range) {
+  Cell<D> lo, hi;
+  for (int a = 0; a < D; ++a) {
+    lo[a] = std::int64_t(std::floor(origin[a] - range)) - 1;
+    hi[a] = std::int64_t(std::floor(origin[a] + range)) + 1;
+  }
+  checkRepresentable<D>(lo, hi);
+  return {lo, hi};
+}
+
+// --- free space --------------------------------------------------------------
+
+/// The cells crossed by observation i's beams, from the sensor to each point
+/// (or to max_range along it).
+template <int D>
+void freeSpaceOf(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
+                 const CellGrid& grid, RegionMarker<D>& marker, std::vector<std::uint64_t>& out) {
+  if (points.empty()) return;
+  const double range = params.max_range / grid.size;
+  const auto o = grid.inCells<D>(origin);
+  // The box of the beams: the origin and every (clipped) end point.
+  std::vector<std::array<double, D>> ends;
+  ends.reserve(points.size());
+  Cell<D> lo = cellOf<D>(o), hi = lo;
+  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p) {
+    std::array<double, D> e = grid.inCells<D>(p->cast<double>());
+    double length = 0;
+    for (int a = 0; a < D; ++a) length += (e[a] - o[a]) * (e[a] - o[a]);
+    length = std::sqrt(length);
+    if (length > range)
+      for (int a = 0; a < D; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+    const Cell<D> c = cellOf<D>(e);
+    for (int a = 0; a < D; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+    ends.push_back(e);
+  }
+  checkRepresentable<D>(lo, hi);
+  marker.reset(lo, hi);
+  for (const auto& e : ends)
+    traverse<D>(o, e, [&](const Cell<D>& c, double) {
+      marker.mark(c);
+      return true;
+    });
+  marker.emit(out);
+}
+
+// --- visibility --------------------------------------------------------------
+
+/// The occupied cells of the plane, in tiles of 64 x 64 found by hash: any
+/// extent, memory in proportion to the occupied area.
+class OccupancyGrid {
+ public:
+  OccupancyGrid() = default;
+  explicit OccupancyGrid(const std::vector<std::uint64_t>& occupied_keys) {
+    for (std::uint64_t key : occupied_keys) set(key, true);
+  }
+  /// Marks a plane cell (keyOf<2>) occupied or free. Readers must not run meanwhile.
+  void set(std::uint64_t key, bool occupied) {
+    const std::uint64_t ux = key >> 32, uy = key & 0xffffffffu;
+    const std::uint64_t tile = ((ux >> 6) << 32) | (uy >> 6);
+    auto [it, added] = index_.emplace(tile, std::uint32_t(tiles_.size()));
+    if (added) tiles_.emplace_back(std::array<std::uint64_t, 64>{});
+    auto& word = tiles_[it->second][ux & 63];
+    const std::uint64_t bit = std::uint64_t(1) << (uy & 63);
+    word = occupied ? (word | bit) : (word & ~bit);
+  }
+
+  /// One ray caster per thread: it remembers the last tile it looked at.
+  class Reader {
+   public:
+    explicit Reader(const OccupancyGrid& grid) : grid_(grid) {}
+    bool occupied(const Cell<2>& c) {
+      const std::uint64_t ux = std::uint64_t(c[0] + kBias2), uy = std::uint64_t(c[1] + kBias2);
+      const std::uint64_t tile = ((ux >> 6) << 32) | (uy >> 6);
+      if (tile != last_tile_) {
+        const auto it = grid_.index_.find(tile);
+        last_ = it == grid_.index_.end() ? nullptr : &grid_.tiles_[it->second];
+        last_tile_ = tile;
+      }
+      return last_ && ((*last_)[ux & 63] >> (uy & 63) & 1);
+    }
+
+   private:
+    const OccupancyGrid& grid_;
+    std::uint64_t last_tile_ = std::numeric_limits<std::uint64_t>::max();
+    const std::array<std::uint64_t, 64>* last_ = nullptr;
+  };
+
+ private:
+  std::unordered_map<std::uint64_t, std::uint32_t> index_;
+  std::vector<std::array<std::uint64_t, 64>> tiles_;
+};
+
+/// Whether point p of an observation whose sensor is at `origin` feeds the
+/// occupancy grid: in 3D only the band about the sensor's height, so that
+/// floor and ceiling do not close the view.
+inline bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, const RegionParameters& params, bool planar) {
+  if (planar) return true;
+  const double height = double(p.z()) - origin.z();
+  return height >= params.band_low && height <= params.band_high;
+}
+
+/// The cells visible from observation i's position: rays all around it at a
+/// fixed set of world angles (so the heading plays no part), each stopped by
+/// the first occupied cell it enters beyond the clearance, that cell included.
+inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
+                         const CellGrid& grid, bool planar, OccupancyGrid::Reader& occupancy, RegionMarker<2>& own,
+                         RegionMarker<2>& marker, std::vector<std::uint64_t>& out) {
+  if (points.empty()) return;  // an observation with no point sensed nothing
+  const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
+  const auto o = grid.inCells<2>(origin);
+  const auto [lo, hi] = boxAround<2>(o, range);
+  // The observation's own surfaces block its view even where too few others
+  // saw them to make them occupied: its points agree with its own pose. A
+  // ray's direction is covered when one of its points lies that way.
+  // Adjacent rays at most one cell apart at full range.
+  const double kTwoPi = 2.0 * 3.14159265358979323846;
+  const int rays = std::max(64, int(std::ceil(kTwoPi * range)));
+  std::vector<char> covered(rays, 0);
+  own.reset(lo, hi);
+  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p)
+    if (inBand(*p, origin, params, planar)) {
+      const auto e = grid.inCells<2>(p->cast<double>());
+      const Cell<2> c = cellOf<2>(e);
+      if (c[0] >= lo[0] && c[0] <= hi[0] && c[1] >= lo[1] && c[1] <= hi[1]) own.mark(c);
+      double angle = std::atan2(e[1] - o[1], e[0] - o[0]);
+      if (angle < 0) angle += kTwoPi;
+      covered[std::min(rays - 1, int(std::lround(angle / kTwoPi * rays)) % rays)] = 1;
+    }
+  marker.reset(lo, hi);
+  for (int r = 0; r < rays; ++r) {
+    const double angle = kTwoPi * r / rays;
+    const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
+    // Where the observation looked, its own beams say what it saw: only its
+    // own surfaces stop the ray, so drifted copies of other observations'
+    // walls do not cut its view. Elsewhere (behind a forward laser, beside
+    // a camera) the occupancy of all observations stands in for its eyes.
+    const bool own_view = covered[r];
+    // Only the occupied cells a ray starts among are passed, and only
+    // within the clearance: once it has crossed a free cell, the next
+    // occupied cell is a wall seen from inside and stops it.
+    bool crossed_free = false;
+    traverse<2>(o, end, [&](const Cell<2>& c, double t) {
+      marker.mark(c);
+      if (!own.marked(c) && (own_view || !occupancy.occupied(c))) return crossed_free = true;
+      return !crossed_free && t < clear;
+    });
+  }
+  marker.emit(out);
+}
+
+inline void checkParameters(const RegionParameters& p) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(p.cell_size)) throw std::invalid_argument("region cell size must be finite and > 0");
+  if (!positive(p.max_range)) throw std::invalid_argument("region range must be finite and > 0");
+  // 2000 cells keeps a region's bitmap (4000^2 cells in 2D) within the dense marker.
+  if (p.max_range / p.cell_size > 2000)
+    throw std::invalid_argument("region range is more than 2000 cells: raise the cell size or lower the range");
+  if (!(std::isfinite(p.clearance) && p.clearance >= 0)) throw std::invalid_argument("clearance must be finite and >= 0");
+  if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
+  if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
+    throw std::invalid_argument("height band must be finite with low < high");
+}
+
+/// Scratch of occupancyEvidence, reused across observations.
+struct EvidenceScratch {
+  RegionMarker<2> marker;
+  std::vector<Cell<2>> ends;
+  std::vector<std::array<double, 2>> targets;
+};
+
+/// One observation's evidence for the occupancy grid: the plane cells its
+/// points (in the band) lie in, and the cells its beams cross within range
+/// without ending there, both ascending.
+inline void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
+                              const CellGrid& grid, bool planar, EvidenceScratch& s, std::vector<std::uint64_t>& hit,
+                              std::vector<std::uint64_t>& crossed) {
+  if (points.empty()) return;
+  const double range = params.max_range / grid.size;
+  s.ends.clear();
+  s.targets.clear();
+  const auto o = grid.inCells<2>(origin);
+  Cell<2> lo = cellOf<2>(o), hi = lo;
+  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p) {
+    if (!inBand(*p, origin, params, planar)) continue;
+    std::array<double, 2> e = grid.inCells<2>(p->cast<double>());
+    s.ends.push_back(cellOf<2>(e));
+    // The beam counts as seeing through the cells it crosses within range.
+    const double length = std::hypot(e[0] - o[0], e[1] - o[1]);
+    if (length > range)
+      for (int a = 0; a < 2; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+    s.targets.push_back(e);
+    const Cell<2> t = cellOf<2>(e);
+    for (int a = 0; a < 2; ++a)
+      lo[a] = std::min({lo[a], t[a], s.ends.back()[a]}), hi[a] = std::max({hi[a], t[a], s.ends.back()[a]});
+  }
+  s.marker.reset(lo, hi);
+  for (const Cell<2>& c : s.ends) s.marker.mark(c);
+  s.marker.emit(hit);
+  s.marker.reset(lo, hi);
+  for (const auto& e : s.targets)
+    traverse<2>(o, e, [&](const Cell<2>& c, double) {
+      s.marker.mark(c);
+      return true;
+    });
+  for (const Cell<2>& c : s.ends) s.marker.unmark(c);  // a surface it saw is not a cell it saw through
+  s.marker.emit(crossed);
+}
+
+/// Whether a cell with this evidence is occupied (RegionParameters::min_observations).
+inline bool occupiedBy(std::size_t hits, std::size_t misses, const RegionParameters& params) {
+  return hits >= std::size_t(params.min_observations) && hits >= misses;
+}
+
+/// True when the sensor and every point lie within `tolerance` of height z0
+/// (one observation of planar, 2D data).
+inline bool observationPlanar(PointSpan points, const Eigen::Vector3d& origin, double z0, double tolerance) {
+  if (std::abs(origin.z() - z0) > tolerance) return false;
+  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p)
+    if (std::abs(double(p->z()) - z0) > tolerance) return false;
+  return true;
+}
+
+/// Whether an observation's cell indices fit a key (2D or 3D): its sensor
+/// and its points' box within the key's range, less the region's reach.
+inline bool withinReach(const Eigen::Vector3d& origin, const Eigen::AlignedBox3f& box, const RegionParameters& params,
+                        bool volumetric) {
+  const double limit = double((volumetric ? kBias3 : kBias2) - 4) - std::ceil(params.max_range / params.cell_size);
+  const auto within = [&](const Eigen::Vector3d& p) {
+    const int axes = volumetric ? 3 : 2;
+    for (int a = 0; a < axes; ++a)
+      if (!(std::abs(p[a] / params.cell_size) < limit)) return false;
+    return true;
+  };
+  return within(origin) &&
+         (box.isEmpty() || (within(box.min().cast<double>()) && within(box.max().cast<double>())));
+}
+
+/// The message of an observation outside withinReach.
+inline std::string reachMessage(const RegionParameters& params) {
+  return "region grid: a point lies too far from the first observation for " + std::to_string(params.cell_size) +
+         " m cells (raise --cell)";
+}
+
+}  // namespace region_cells
+}  // namespace obsgroup
