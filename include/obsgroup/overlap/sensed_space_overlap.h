@@ -86,6 +86,11 @@ class SensedSpaceOverlap {
   /// std::invalid_argument on a null cloud, a non-finite pose or a voxel
   /// leaf too small for a cloud's extent.
   WorldPoints toWorld(const std::vector<Observation<PointT>>& observations) const;
+  /// One observation's points as toWorld gives them, re-centred on `origin`
+  /// (toWorld's: the first observation's position). Throws
+  /// std::invalid_argument as toWorld does.
+  std::vector<Eigen::Vector3f> observationToWorld(const Observation<PointT>& observation,
+                                                  const Eigen::Vector3d& origin) const;
 
   /// The region of every observation under the free-space or visibility
   /// model (what compute() measures the overlap of), e.g. to draw it.
@@ -99,8 +104,6 @@ class SensedSpaceOverlap {
   OverlapResult compute(const std::vector<Observation<PointT>>& observations, const WorldPoints& world) const;
 
  private:
-  std::vector<Eigen::Vector3f> observationToWorld(const Observation<PointT>& observation,
-                                                  const Eigen::Vector3d& origin) const;
   MatchCounts countMatchesPclSearch(const WorldPoints& world) const;
 
   double delta_ = 0.1;

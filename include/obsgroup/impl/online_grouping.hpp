@@ -1,0 +1,301 @@
+#pragma once
+
+#include "obsgroup/common/invalid_observation.h"
+#include "obsgroup/common/parallel_for.h"
+#include "obsgroup/online_grouping.h"
+#include "obsgroup/overlap/impl/sensed_space_overlap.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace obsgroup {
+
+template <typename PointT>
+OnlineGrouping<PointT>::OnlineGrouping() {
+  const ObservationGrouping<PointT> defaults;
+  setParametersFrom(defaults);
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::usePaperMethod() {
+  ObservationGrouping<PointT> paper;
+  paper.usePaperMethod();
+  setParametersFrom(paper);
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::setParametersFrom(const ObservationGrouping<PointT>& grouping) {
+  const int threads = config_.getNumberOfThreads();
+  const InterruptFlag* interrupt = config_.getInterruptFlag();
+  config_.setSensedSpaceModel(grouping.getSensedSpaceModel());
+  config_.setRegionParameters(grouping.getRegionParameters());
+  config_.setMatchDistance(grouping.getMatchDistance());
+  config_.setVoxelLeafSize(grouping.getVoxelLeafSize());
+  config_.setNumberOfThreads(threads);
+  config_.setInterruptFlag(interrupt);
+  diagonal_ = grouping.getDiagonalWeight();
+  options_ = grouping.getPartitionOptions();
+  reconfigure();
+}
+
+template <typename PointT>
+PartitionOptions OnlineGrouping<PointT>::getPartitionOptions() const {
+  PartitionOptions options = options_;
+  options.threads = config_.getNumberOfThreads();
+  options.interrupt = config_.getInterruptFlag();
+  options.eigen.elimination_rank.clear();  // each node orders itself (SplitCache)
+  return options;
+}
+
+template <typename PointT>
+int OnlineGrouping<PointT>::firstPresent() const {
+  for (int i = 0; i < int(slots_.size()); ++i)
+    if (slots_[i].present) return i;
+  return -1;
+}
+
+template <typename PointT>
+std::vector<Eigen::Vector3f> OnlineGrouping<PointT>::worldPointsOf(int id, const Observation<PointT>& observation,
+                                                                   const Eigen::Vector3d& origin) const {
+  if (!observation.cloud) throw InvalidObservation(id, "null cloud");
+  if (!observation.pose.matrix().allFinite()) throw InvalidObservation(id, "pose is not finite");
+  try {
+    return config_.observationToWorld(observation, origin);
+  } catch (const InvalidObservation&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InvalidObservation(id, e.what());
+  }
+}
+
+template <typename PointT>
+int OnlineGrouping<PointT>::insert(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose) {
+  const int id = static_cast<int>(slots_.size());
+  const Observation<PointT> observation{cloud, pose};
+  const bool first = firstPresent() < 0;
+  // The common frame is re-centred on the first observation present, as
+  // SensedSpaceOverlap::toWorld does (the same points, to the bit).
+  const Eigen::Vector3d origin = first && pose.translation().allFinite() ? Eigen::Vector3d(pose.translation()) : origin_;
+  std::vector<Eigen::Vector3f> points = worldPointsOf(id, observation, origin);
+  if (overlap_ && !reconfigure_) {
+    try {
+      overlap_->check(id, points, pose.translation() - origin);
+    } catch (const std::invalid_argument& e) {
+      throw InvalidObservation(id, e.what());
+    }
+  }
+  slots_.push_back({true, observation});
+  group_of_.push_back(-1);
+  origin_ = origin;
+  if (overlap_ && !reconfigure_) overlap_->set(id, std::move(points), pose.translation() - origin);
+  return id;
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
+  if (!contains(id)) throw std::out_of_range("updatePose: no observation " + std::to_string(id));
+  if (!pose.matrix().allFinite()) throw InvalidObservation(id, "pose is not finite");
+  Observation<PointT> moved = slots_[id].observation;
+  moved.pose = pose;
+  if (id == firstPresent()) {
+    // The common frame moves with it: every observation is re-centred.
+    const Observation<PointT> kept = slots_[id].observation;
+    slots_[id].observation = moved;
+    try {
+      recentreAll();
+    } catch (...) {
+      slots_[id].observation = kept;
+      recentreAll();
+      throw;
+    }
+    return;
+  }
+  std::vector<Eigen::Vector3f> points = worldPointsOf(id, moved, origin_);
+  if (overlap_ && !reconfigure_) {
+    try {
+      overlap_->check(id, points, pose.translation() - origin_);
+    } catch (const std::invalid_argument& e) {
+      throw InvalidObservation(id, e.what());
+    }
+    overlap_->set(id, std::move(points), pose.translation() - origin_);
+  }
+  slots_[id].observation = moved;
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::remove(int id) {
+  if (!contains(id)) throw std::out_of_range("remove: no observation " + std::to_string(id));
+  const bool was_first = id == firstPresent();
+  slots_[id].present = false;
+  slots_[id].observation = Observation<PointT>{};
+  if (was_first) {
+    recentreAll();
+  } else if (overlap_ && !reconfigure_) {
+    overlap_->erase(id);
+  }
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::recentreAll() {
+  const int first = firstPresent();
+  const Eigen::Vector3d origin =
+      first >= 0 ? Eigen::Vector3d(slots_[first].observation.pose.translation()) : Eigen::Vector3d::Zero();
+  auto fresh = std::make_unique<IncrementalOverlap>(config_.getSensedSpaceModel(), config_.getMatchDistance(),
+                                                    config_.getRegionParameters());
+  std::vector<std::vector<Eigen::Vector3f>> points(slots_.size());
+  parallelFor(slots_.size(), config_.getNumberOfThreads(), 4, [&](std::size_t i) {
+    if (slots_[i].present) points[i] = worldPointsOf(int(i), slots_[i].observation, origin);
+  });
+  for (int i = 0; i < int(slots_.size()); ++i) {
+    if (!slots_[i].present) continue;
+    const Eigen::Vector3d sensor = slots_[i].observation.pose.translation() - origin;
+    try {
+      fresh->check(i, points[i], sensor);
+    } catch (const std::invalid_argument& e) {
+      throw InvalidObservation(i, e.what());
+    }
+    fresh->set(i, std::move(points[i]), sensor);
+  }
+  overlap_ = std::move(fresh);
+  origin_ = origin;
+  reconfigure_ = false;
+}
+
+template <typename PointT>
+GroupUpdate OnlineGrouping<PointT>::update() {
+  if (reconfigure_ || !overlap_) {
+    cache_.clear();
+    recentreAll();
+  }
+  GroupUpdate out;
+  const std::vector<int> changed_slots = overlap_->update(config_.getNumberOfThreads(), config_.getInterruptFlag());
+  out.observations_recomputed = overlap_->recomputedLastUpdate();
+  const std::vector<int> ids = overlap_->slots();
+  W_ = overlap_->weightMatrix(diagonal_);
+  std::vector<char> changed(ids.size(), 0);
+  for (int slot : changed_slots)
+    changed[std::lower_bound(ids.begin(), ids.end(), slot) - ids.begin()] = 1;
+  partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, cache_);
+  out.split_nodes_reused = cache_.reusedNodes();
+  out.split_nodes_computed = cache_.computedNodes();
+
+  warnings_.clear();
+  for (int id : ids)
+    if (overlap_->pointCount(id) == 0)
+      warnings_.push_back("observation " + std::to_string(id) +
+                          " has no finite point: it overlaps nothing and forms a group of its own");
+  warnings_.insert(warnings_.end(), partition_.warnings.begin(), partition_.warnings.end());
+
+  std::vector<std::vector<int>> groups;
+  for (const auto& group : partition_.groups) {
+    std::vector<int> members;
+    for (int k : group) members.push_back(ids[k]);
+    groups.push_back(std::move(members));
+  }
+  assignGroupIds(groups, out);
+  return out;
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out) {
+  // How many members each new group takes from each old group.
+  std::vector<std::map<int, int>> from_old(groups.size());  // new group -> old id -> members
+  std::map<int, std::map<int, int>> to_new;                  // old id -> new group -> members
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int id : groups[g]) {
+      const int old = group_of_[id];
+      if (old < 0) continue;
+      ++from_old[g][old];
+      ++to_new[old][int(g)];
+    }
+  // Each old group's heir: the new group holding most of it (the first on a tie).
+  std::map<int, int> heir;
+  for (const auto& [old, counts] : to_new) {
+    int best = -1, best_count = 0;
+    for (const auto& [g, count] : counts)
+      if (count > best_count) best = g, best_count = count;
+    heir[old] = best;
+  }
+  std::vector<int> new_id(groups.size(), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    int best = -1, best_count = 0;
+    for (const auto& [old, count] : from_old[g])
+      if (heir[old] == int(g) && count > best_count) best = old, best_count = count;
+    new_id[g] = best >= 0 ? best : next_group_id_++;
+  }
+
+  std::map<int, std::vector<int>> next;
+  for (std::size_t g = 0; g < groups.size(); ++g) next[new_id[g]] = groups[g];
+  std::vector<GroupChange> splits, merges, others;
+  for (const auto& [old, counts] : to_new)
+    if (counts.size() > 1) {
+      GroupChange c{GroupChange::Kind::Split, old, {}, {}};
+      for (const auto& [g, count] : counts) c.related.push_back(new_id[g]);
+      std::sort(c.related.begin(), c.related.end());
+      splits.push_back(std::move(c));
+    }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const int id = new_id[g];
+    if (from_old[g].size() > 1) {
+      GroupChange c{GroupChange::Kind::Merged, id, {}, groups[g]};
+      for (const auto& [old, count] : from_old[g]) c.related.push_back(old);
+      merges.push_back(std::move(c));
+      continue;
+    }
+    const auto before = groups_.find(id);
+    if (before == groups_.end()) {
+      // A group of only new observations, or one split off an old group (reported as the split).
+      if (from_old[g].empty()) others.push_back({GroupChange::Kind::Created, id, {}, groups[g]});
+      continue;
+    }
+    if (before->second == groups[g]) continue;
+    const bool grew = std::includes(groups[g].begin(), groups[g].end(), before->second.begin(), before->second.end());
+    const bool shrank = std::includes(before->second.begin(), before->second.end(), groups[g].begin(), groups[g].end());
+    if (shrank && to_new[id].size() > 1) continue;  // reported as the split
+    const auto kind = grew ? GroupChange::Kind::Grown : shrank ? GroupChange::Kind::Shrunk : GroupChange::Kind::Changed;
+    others.push_back({kind, id, {}, groups[g]});
+  }
+  for (const auto& [old, members] : groups_)
+    if (!to_new.count(old)) others.push_back({GroupChange::Kind::Removed, old, {}, {}});
+  std::sort(others.begin(), others.end(), [](const GroupChange& a, const GroupChange& b) { return a.group < b.group; });
+  out.changes = std::move(splits);
+  out.changes.insert(out.changes.end(), merges.begin(), merges.end());
+  out.changes.insert(out.changes.end(), others.begin(), others.end());
+
+  groups_ = std::move(next);
+  std::fill(group_of_.begin(), group_of_.end(), -1);
+  for (const auto& [id, members] : groups_)
+    for (int member : members) group_of_[member] = id;
+}
+
+template <typename PointT>
+std::vector<int> OnlineGrouping<PointT>::getIds() const {
+  std::vector<int> ids;
+  for (int i = 0; i < int(slots_.size()); ++i)
+    if (slots_[i].present) ids.push_back(i);
+  return ids;
+}
+
+template <typename PointT>
+const Observation<PointT>& OnlineGrouping<PointT>::getObservation(int id) const {
+  if (!contains(id)) throw std::out_of_range("getObservation: no observation " + std::to_string(id));
+  return slots_[id].observation;
+}
+
+template <typename PointT>
+std::vector<Observation<PointT>> OnlineGrouping<PointT>::getObservations() const {
+  std::vector<Observation<PointT>> out;
+  for (const Slot& s : slots_)
+    if (s.present) out.push_back(s.observation);
+  return out;
+}
+
+template <typename PointT>
+int OnlineGrouping<PointT>::getGroupOf(int id) const {
+  return id >= 0 && id < int(group_of_.size()) ? group_of_[id] : -1;
+}
+
+}  // namespace obsgroup
+
+#define PCL_INSTANTIATE_OnlineGrouping(T) template class obsgroup::OnlineGrouping<T>;

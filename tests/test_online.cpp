@@ -1,0 +1,275 @@
+// Online grouping: after any sequence of inserts, pose updates and removals,
+// the groups and W equal a from-scratch ObservationGrouping::compute() on the
+// observations present; untouched groups keep their ids.
+
+#include "scenarios.h"
+#include "test_support.h"
+
+#include <obsgroup/online_grouping.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace obsgroup {
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+/// The simulated office, 360-degree laser, with drifted poses (as a SLAM
+/// front end gives them: the visibility model's occupancy then differs
+/// between observations, so inserts reach other observations' regions).
+std::vector<Observation<pcl::PointXYZ>> driftedOffice(int count = 77) {
+  auto obs = test::simulate<pcl::PointXYZ>(sim::office(), sim::officeRoute(count), sim::laser360());
+  std::vector<Eigen::Isometry3d> truth;
+  for (const auto& o : obs) truth.push_back(o.pose);
+  const auto drifted = sim::drift(truth, 7);
+  for (std::size_t k = 0; k < obs.size(); ++k) obs[k].pose = drifted[k];
+  return obs;
+}
+
+ObservationGrouping<pcl::PointXYZ> batchLike(SensedSpaceModel model) {
+  ObservationGrouping<pcl::PointXYZ> batch;
+  batch.setSensedSpaceModel(model);
+  return batch;
+}
+
+/// W and the groups of `online` equal a batch run on its observations.
+void expectEqualsBatch(const OnlineGrouping<pcl::PointXYZ>& online, ObservationGrouping<pcl::PointXYZ> batch,
+                       const std::string& when) {
+  SCOPED_TRACE(when);
+  batch.clear();
+  for (const auto& o : online.getObservations()) batch.addObservation(o.cloud, o.pose);
+  const Partition expected = batch.compute();
+  const WeightMatrix& W = online.getWeightMatrix();
+  const WeightMatrix& B = batch.getWeightMatrix();
+  ASSERT_EQ(W.rows(), B.rows());
+  ASSERT_EQ(W.nonZeros(), B.nonZeros());
+  for (int k = 0; k < W.outerSize(); ++k) {
+    WeightMatrix::InnerIterator a(W, k), b(B, k);
+    for (; a && b; ++a, ++b) {
+      ASSERT_EQ(a.row(), b.row()) << "column " << k;
+      ASSERT_EQ(a.value(), b.value()) << "W(" << a.row() << ", " << k << ")";  // bit for bit
+    }
+  }
+  EXPECT_EQ(online.getPartition().groups, expected.groups);
+  ASSERT_EQ(online.getPartition().splits.size(), expected.splits.size());
+  for (std::size_t s = 0; s < expected.splits.size(); ++s) {
+    EXPECT_EQ(online.getPartition().splits[s].members, expected.splits[s].members);
+    if (std::isfinite(expected.splits[s].ncut)) EXPECT_EQ(online.getPartition().splits[s].ncut, expected.splits[s].ncut);
+  }
+  // The id view agrees with the position view.
+  const std::vector<int> ids = online.getIds();
+  std::size_t members = 0;
+  for (const auto& [group, list] : online.getGroups()) {
+    members += list.size();
+    for (int id : list) EXPECT_EQ(online.getGroupOf(id), group);
+  }
+  EXPECT_EQ(members, ids.size());
+}
+
+class OnlineEqualsBatch : public ::testing::TestWithParam<SensedSpaceModel> {};
+
+TEST_P(OnlineEqualsBatch, AfterEveryInsertInLogOrder) {
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setSensedSpaceModel(GetParam());
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    EXPECT_EQ(online.insert(obs[k].cloud, obs[k].pose), int(k));
+    online.update();
+    if (k % 4 == 3 || k + 1 == obs.size()) expectEqualsBatch(online, batchLike(GetParam()), "insert " + std::to_string(k));
+  }
+}
+
+TEST_P(OnlineEqualsBatch, AfterPoseUpdatesAndRemovals) {
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setSensedSpaceModel(GetParam());
+  for (const auto& o : obs) online.insert(o.cloud, o.pose);
+  online.update();
+  expectEqualsBatch(online, batchLike(GetParam()), "all inserted");
+  // A loop closure moves a stretch of the route by a few decimetres.
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  correction.translate(Eigen::Vector3d(0.3, -0.2, 0.0));
+  correction.rotate(Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()));
+  for (int k = 40; k < 60; ++k) online.updatePose(k, correction * obs[k].pose);
+  online.update();
+  expectEqualsBatch(online, batchLike(GetParam()), "poses updated");
+  for (int id : {12, 13, 50, 76}) online.remove(id);
+  online.update();
+  expectEqualsBatch(online, batchLike(GetParam()), "removed");
+  online.remove(0);  // the first observation: the common frame moves to observation 1
+  online.updatePose(1, correction * obs[1].pose);
+  online.update();
+  expectEqualsBatch(online, batchLike(GetParam()), "first removed, new first moved");
+  EXPECT_EQ(online.insert(obs[0].cloud, obs[0].pose), 77);  // ids are never reused
+  online.update();
+  expectEqualsBatch(online, batchLike(GetParam()), "re-inserted");
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, OnlineEqualsBatch,
+                         ::testing::Values(SensedSpaceModel::Visibility, SensedSpaceModel::FreeSpace,
+                                           SensedSpaceModel::Points),
+                         [](const auto& info) {
+                           std::string name = toString(info.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name;
+                         });
+
+TEST(OnlineGrouping, PaperMethodEqualsBatch) {
+  const auto obs = driftedOffice(40);
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.usePaperMethod();
+  ObservationGrouping<pcl::PointXYZ> batch;
+  batch.usePaperMethod();
+  for (const auto& o : obs) online.insert(o.cloud, o.pose);
+  online.update();
+  expectEqualsBatch(online, batch, "paper");
+}
+
+TEST(OnlineGrouping, ReportsChangesAndKeepsIdsOfUntouchedGroups) {
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  for (const auto& o : obs) online.insert(o.cloud, o.pose);
+  GroupUpdate first = online.update();
+  ASSERT_GT(online.getGroups().size(), 2u);
+  EXPECT_EQ(first.changes.size(), online.getGroups().size());
+  for (const auto& c : first.changes) EXPECT_EQ(c.kind, GroupChange::Kind::Created);
+  const auto before = online.getGroups();
+
+  // Nothing changed: nothing is recomputed, nothing reported.
+  GroupUpdate idle = online.update();
+  EXPECT_TRUE(idle.changes.empty());
+  EXPECT_EQ(idle.observations_recomputed, 0u);
+  EXPECT_EQ(idle.split_nodes_computed, 0u);
+  EXPECT_EQ(online.getGroups(), before);
+
+  // A scan 1 km away overlaps nothing: one group is created, the others keep ids and members.
+  Eigen::Isometry3d far = obs[5].pose;
+  far.translation().x() += 1000.0;
+  const int id = online.insert(obs[5].cloud, far);
+  GroupUpdate added = online.update();
+  ASSERT_EQ(added.changes.size(), 1u);
+  EXPECT_EQ(added.changes[0].kind, GroupChange::Kind::Created);
+  EXPECT_EQ(added.changes[0].members, std::vector<int>{id});
+  for (const auto& [group, members] : before) EXPECT_EQ(online.getGroups().at(group), members);
+  EXPECT_EQ(added.observations_recomputed, 1u);
+
+  // Removing it removes its group.
+  online.remove(id);
+  GroupUpdate removed = online.update();
+  ASSERT_EQ(removed.changes.size(), 1u);
+  EXPECT_EQ(removed.changes[0].kind, GroupChange::Kind::Removed);
+  EXPECT_EQ(online.getGroups(), before);
+}
+
+TEST(OnlineGrouping, LoopClosureRepartitionsOnlyTheGroupsItTouches) {
+  // A long building, points model: a row of W changes only for the moved
+  // observations and the ones they overlap.
+  const auto obs = test::simulate<pcl::PointXYZ>(sim::longBuilding(300.0), sim::longBuildingRoute(300.0, 300),
+                                                 sim::fullTurnLaser(180));
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setSensedSpaceModel(SensedSpaceModel::Points);
+  for (const auto& o : obs) online.insert(o.cloud, o.pose);
+  online.update();
+  const auto before = online.getGroups();
+  const WeightMatrix W_before = online.getWeightMatrix();
+  ASSERT_GT(before.size(), 4u);
+
+  Eigen::Isometry3d correction = Eigen::Isometry3d::Identity();
+  correction.translate(Eigen::Vector3d(0.05, 0.04, 0.0));
+  std::set<int> touched;
+  for (int k = 100; k < 150; ++k) {
+    online.updatePose(k, correction * obs[k].pose);
+    touched.insert(k);
+  }
+  const GroupUpdate update = online.update();
+  // The observations whose row can change: the moved ones and their partners, before or after.
+  for (const WeightMatrix* W : {&W_before, &online.getWeightMatrix()})
+    for (int k = 100; k < 150; ++k)
+      for (WeightMatrix::InnerIterator it(*W, k); it; ++it) touched.insert(int(it.row()));
+  std::size_t nodes_touched = 0;
+  for (const SplitNode& node : online.getPartition().splits) {
+    bool hit = false;
+    for (int m : node.members) hit = hit || touched.count(m);
+    nodes_touched += hit;
+  }
+  EXPECT_LE(update.split_nodes_computed, nodes_touched);
+  EXPECT_EQ(update.split_nodes_computed + update.split_nodes_reused, online.getPartition().splits.size());
+  EXPECT_GT(update.split_nodes_reused, 0u);
+  EXPECT_EQ(update.observations_recomputed, 50u);
+  // Groups away from the closure keep their ids and members.
+  std::size_t kept = 0;
+  for (const auto& [group, members] : before) {
+    bool away = true;
+    for (int m : members) away = away && !touched.count(m);
+    if (!away) continue;
+    ASSERT_TRUE(online.getGroups().count(group)) << "group " << group;
+    EXPECT_EQ(online.getGroups().at(group), members);
+    ++kept;
+  }
+  EXPECT_GT(kept, 0u) << before.size() << " groups, " << touched.size() << " observations touched, "
+                      << update.split_nodes_computed << " of " << online.getPartition().splits.size()
+                      << " split nodes computed";
+  expectEqualsBatch(online, batchLike(SensedSpaceModel::Points), "loop closure");
+}
+
+TEST(OnlineGrouping, SameResultWhateverTheThreadCount) {
+  const auto obs = driftedOffice(50);
+  std::vector<std::map<int, std::vector<int>>> groups;
+  std::vector<WeightMatrix> weights;
+  for (int threads : {1, 2, 3}) {
+    OnlineGrouping<pcl::PointXYZ> online;
+    online.setNumberOfThreads(threads);
+    for (const auto& o : obs) {
+      online.insert(o.cloud, o.pose);
+      online.update();
+    }
+    groups.push_back(online.getGroups());
+    weights.push_back(online.getWeightMatrix());
+  }
+  for (std::size_t k = 1; k < groups.size(); ++k) {
+    EXPECT_EQ(groups[k], groups[0]);
+    EXPECT_EQ((weights[k] - weights[0]).norm(), 0.0);
+  }
+}
+
+TEST(OnlineGrouping, BadInputThrowsNamingTheIdAndChangesNothing) {
+  const auto obs = driftedOffice(10);
+  OnlineGrouping<pcl::PointXYZ> online;
+  for (int k = 0; k < 5; ++k) online.insert(obs[k].cloud, obs[k].pose);
+  online.update();
+  const auto groups = online.getGroups();
+
+  try {
+    online.insert(nullptr, obs[5].pose);
+    FAIL() << "a null cloud was accepted";
+  } catch (const InvalidObservation& e) {
+    EXPECT_EQ(e.index(), 5);
+    EXPECT_NE(std::string(e.what()).find("observation 5"), std::string::npos);
+  }
+  Eigen::Isometry3d nan_pose = obs[5].pose;
+  nan_pose.translation().x() = std::nan("");
+  try {
+    online.insert(obs[5].cloud, nan_pose);
+    FAIL() << "a NaN pose was accepted";
+  } catch (const InvalidObservation& e) {
+    EXPECT_EQ(e.index(), 5);
+  }
+  EXPECT_THROW(online.updatePose(2, nan_pose), InvalidObservation);
+  EXPECT_THROW(online.updatePose(0, nan_pose), InvalidObservation);
+  EXPECT_THROW(online.updatePose(42, obs[0].pose), std::out_of_range);
+  EXPECT_THROW(online.remove(42), std::out_of_range);
+
+  EXPECT_EQ(online.getIds(), (std::vector<int>{0, 1, 2, 3, 4}));
+  const GroupUpdate nothing = online.update();
+  EXPECT_TRUE(nothing.changes.empty());
+  EXPECT_EQ(online.getGroups(), groups);
+  EXPECT_EQ(online.insert(obs[5].cloud, obs[5].pose), 5);  // the failed calls took no id
+  online.update();
+  expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "after bad input");
+}
+
+}  // namespace
+}  // namespace obsgroup
