@@ -147,7 +147,7 @@ struct IncrementalOverlap::State {
     markChanged(i);
     markChanged(j);
   }
-  /// Adds `step` (+1 or -1) to the cells slots i and j share.
+  /// Adds `step` to the cells slots i and j share.
   void addShared(int i, int j, int step) {
     const PairCounts* old = find(i, j);
     const std::uint32_t now = std::uint32_t(std::int64_t(old ? old->ij : 0) + step);
@@ -294,17 +294,38 @@ struct IncrementalOverlap::State {
       freeSpaceOf<2>(points, s.origin, params, grid, marker2, s.region);
   }
 
-  void removeCell(int i, std::uint64_t key) {
+  /// Changes of the cells slot i shares with each other slot, summed over
+  /// its cells before they are applied: one update of a pair's counts instead
+  /// of one per cell.
+  struct SharedDelta {
+    std::vector<int> delta;  // by slot
+    std::vector<int> touched;
+    void add(int w, int step) {
+      if (w >= int(delta.size())) delta.resize(w + 1, 0);
+      if (delta[w] == 0) touched.push_back(w);
+      delta[w] += step;
+    }
+  };
+
+  void removeCell(int i, std::uint64_t key, SharedDelta& shared) {
     auto it = watchers.find(key);
     auto& list = it->second;
     list.erase(std::find(list.begin(), list.end(), i));
-    for (int w : list) addShared(i, w, -1);
+    for (int w : list) shared.add(w, -1);
     if (list.empty()) watchers.erase(it);
   }
-  void addCell(int i, std::uint64_t key) {
+  void addCell(int i, std::uint64_t key, SharedDelta& shared) {
     auto& list = watchers[key];
-    for (int w : list) addShared(i, w, +1);
+    for (int w : list) shared.add(w, +1);
     list.push_back(i);
+  }
+  void applyShared(int i, SharedDelta& shared) {
+    std::sort(shared.touched.begin(), shared.touched.end());
+    for (int w : shared.touched) {
+      if (shared.delta[w] != 0) addShared(i, w, shared.delta[w]);
+      shared.delta[w] = 0;
+    }
+    shared.touched.clear();
   }
 
   void updateRegions(std::vector<int> dirty, int threads) {
@@ -325,12 +346,14 @@ struct IncrementalOverlap::State {
     parallelForWithScratch(
         affected.size(), threads, 2, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(occupancy)}; },
         [&](std::size_t k, Scratch& s) { computeRegion(slots[affected[k]], s.own, s.marker2, s.marker3, s.reader); });
+    SharedDelta shared;
     for (std::size_t k = 0; k < affected.size(); ++k) {
       const int i = affected[k];
       const std::vector<std::uint64_t>& now = slots[i].region;
       if (now.size() != old[k].size()) markPartners(i);
-      for (std::uint64_t key : difference(old[k], now)) removeCell(i, key);
-      for (std::uint64_t key : difference(now, old[k])) addCell(i, key);
+      for (std::uint64_t key : difference(old[k], now)) removeCell(i, key, shared);
+      for (std::uint64_t key : difference(now, old[k])) addCell(i, key, shared);
+      applyShared(i, shared);
       if (now.size() != old[k].size()) markPartners(i);
     }
     recomputed = affected.size();
