@@ -613,7 +613,7 @@ TEST_F(Cli, UsageMessagesSayWhatIsWrong) {
     EXPECT_EQ(r.err.find("1797"), std::string::npos) << r.err;
   };
   expectUsage("", "a command is required: partition");
-  expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition)");
+  expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition, stream)");
   expectUsage("partition " + input + out + " --sso points --delta 0", "--delta: must be > 0 (got 0)");
   expectUsage("partition " + input + out + " --sso points --delta 0.2cm", "'0.2cm' is not a number");
   expectUsage("partition " + input + out + " --sso points --delta nan", "'nan' is not a finite number");
@@ -1244,4 +1244,133 @@ TEST_F(Cli, PcdFilesNamedByTimestampAreMatchedToTumPosesByTime) {
   r = run("partition " + seq.string() + " -q --poses " + (dir_ / "odd.txt").string() + " -o " + (dir_ / "d").string());
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("odd.txt:1: a pose line has 5 values: neither TUM"), std::string::npos) << r.err;
+}
+
+namespace {
+
+/// The "groups" of a partition.json as written: the text between its key and "splits".
+std::string groupsText(const fs::path& out) {
+  const std::string text = readFile(out / "partition.json");
+  const std::size_t begin = text.find("\"groups\":"), end = text.find("\"splits\":");
+  return begin == std::string::npos || end == std::string::npos ? "" : text.substr(begin, end - begin);
+}
+
+/// The first `count` scans of the simulated ROBOTLASER1 log, stamped `stamps` (seconds).
+std::string stampedLog(const std::vector<std::string>& stamps) {
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string log, line;
+  for (const std::string& stamp : stamps) {
+    std::getline(in, line);
+    log += line.substr(0, line.rfind(" 1.0 host 1.0")) + " " + stamp + " host " + stamp + "\n";
+  }
+  return log;
+}
+
+}  // namespace
+
+TEST_F(Cli, StreamGivesTheGroupsOfPartitionAndPrintsEachChange) {
+  const std::string input = kData + "/office_2d/office.clf";
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "batch").string()).code, 0);
+  const nlohmann::json batch = readJson(dir_ / "batch" / "partition.json");
+  const Result r = run("stream " + input + " -o " + (dir_ / "stream").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(groupsText(dir_ / "stream"), groupsText(dir_ / "batch"));
+  ASSERT_FALSE(groupsText(dir_ / "batch").empty());
+  const nlohmann::json p = readJson(dir_ / "stream" / "partition.json");
+  expectAllOutputs(dir_ / "stream", p);
+  EXPECT_EQ(p.at("parameters").at("mode"), "stream");
+  EXPECT_EQ(p.at("parameters").at("update_every"), 1);
+  EXPECT_EQ(p.at("statistics").at("updates"), 77);
+  for (const char* key : {"points", "edges", "groups", "local_map_points"})
+    EXPECT_EQ(p.at("statistics").at(key), batch.at("statistics").at(key)) << key;
+  EXPECT_TRUE(p.at("timing_s").at("stream").is_number());
+  EXPECT_NE(r.err.find("77 observations"), std::string::npos) << r.err;
+  // One line per change, named after the observation just inserted.
+  std::istringstream lines(r.out);
+  std::string line;
+  std::set<std::string> kinds;
+  std::size_t count = 0;
+  for (; std::getline(lines, line); ++count) {
+    std::istringstream words(line);
+    std::string observation, id, group, number, kind;
+    words >> observation >> id >> group >> number >> kind;
+    EXPECT_EQ(observation, "observation") << line;
+    EXPECT_EQ(id.back(), ':') << line;
+    EXPECT_EQ(group, "group") << line;
+    kinds.insert(kind);
+  }
+  EXPECT_GE(count, 77u);
+  EXPECT_EQ(r.out.rfind("observation 0: group 0 created (1 observation)\n", 0), 0u) << r.out.substr(0, 200);
+  EXPECT_TRUE(kinds.count("grown") && kinds.count("split")) << r.out;
+
+  // Every 10 inserts, quiet: the same groups, nothing printed.
+  const Result quiet = run("stream " + input + " -q --no-pictures --update-every 10 -o " + (dir_ / "ten").string());
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.out, "");
+  EXPECT_EQ(quiet.err, "");
+  EXPECT_EQ(groupsText(dir_ / "ten"), groupsText(dir_ / "batch"));
+  const nlohmann::json ten = readJson(dir_ / "ten" / "partition.json");
+  EXPECT_EQ(ten.at("statistics").at("updates"), 8);  // after 10, 20, ..., 70 and the last (77)
+  EXPECT_EQ(ten.at("parameters").at("update_every"), 10);
+}
+
+TEST_F(Cli, StreamOptionsAndErrors) {
+  const std::string input = kData + "/office_2d/office.clf";
+  EXPECT_NE(run("--help").out.find("stream"), std::string::npos);
+  const Result help = run("stream --help");
+  EXPECT_EQ(help.code, 0);
+  for (const char* option : {"--update-every", "--realtime", "--refine", "--no-pictures", "--threads", "--quiet"})
+    EXPECT_NE(help.out.find(option), std::string::npos) << option;
+  EXPECT_EQ(run("stream " + input + " --update-every 0 -o " + (dir_ / "o").string()).code, 2);
+  // A PCD sequence has no timestamps to replay at.
+  const Result pcd = run("stream " + kData + "/office_3d/pcd --realtime -o " + (dir_ / "o").string());
+  EXPECT_EQ(pcd.code, 2);
+  EXPECT_NE(pcd.err.find("no timestamps"), std::string::npos) << pcd.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+  // An observation the online grouping refuses is named by its line, as partition names it.
+  std::istringstream in(simulatedLog("ROBOTLASER1"));
+  std::string log, line;
+  for (int k = 1; std::getline(in, line); ++k) log += (k == 3 ? shiftedRobotLaserLog(line, 1e12, 0) : line + "\n");
+  writeFile(dir_ / "far.clf", log);
+  const Result far = run("stream " + (dir_ / "far.clf").string() + " -q -o " + (dir_ / "o").string());
+  EXPECT_EQ(far.code, 3);
+  EXPECT_NE(far.err.find("far.clf:3: observation 2: region grid: a point lies too far"), std::string::npos) << far.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+TEST_F(Cli, StreamRealtimeReplaysAtTheLogsStamps) {
+  // 0.6 s of stamps; the one going back is due at once, not slept on.
+  writeFile(dir_ / "short.clf", stampedLog({"100.0", "100.2", "100.1", "100.4", "100.6", "100.6"}));
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = run("stream " + (dir_ / "short.clf").string() + " --realtime --no-pictures -o " +
+                       (dir_ / "rt").string());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GE(seconds, 0.6);
+  EXPECT_LT(seconds, 2.0);
+  const nlohmann::json p = readJson(dir_ / "rt" / "partition.json");
+  EXPECT_EQ(p.at("parameters").at("realtime"), true);
+  EXPECT_GT(p.at("timing_s").at("realtime_wait").get<double>(), 0.4);
+  EXPECT_LT(p.at("timing_s").at("realtime_wait").get<double>(), 0.6 + 0.3);
+  const std::string batch = "partition " + (dir_ / "short.clf").string() + " -q --no-pictures -o ";
+  ASSERT_EQ(run(batch + (dir_ / "b").string()).code, 0);
+  EXPECT_EQ(groupsText(dir_ / "rt"), groupsText(dir_ / "b"));
+  EXPECT_NE(r.out.find("observation 5:"), std::string::npos) << r.out;
+
+  // A stamp that is not a number: an error naming line and field when
+  // replaying at the stamps, nothing otherwise.
+  writeFile(dir_ / "bad.clf", stampedLog({"100.0", "later"}));
+  const Result bad = run("stream " + (dir_ / "bad.clf").string() + " --realtime -q -o " + (dir_ / "x").string());
+  EXPECT_EQ(bad.code, 3);
+  EXPECT_NE(bad.err.find("bad.clf:2: field 'timestamp': 'later' is not a number"), std::string::npos) << bad.err;
+  EXPECT_EQ(run("stream " + (dir_ / "bad.clf").string() + " -q --no-pictures -o " + (dir_ / "y").string()).code, 0);
+
+  // Ctrl-C while waiting for a late stamp stops at once.
+  writeFile(dir_ / "slow.clf", stampedLog({"0", "60"}));
+  const auto interrupted = std::chrono::steady_clock::now();
+  EXPECT_EQ(runInterruptedAfter({"stream", (dir_ / "slow.clf").string(), "--realtime", "-o", (dir_ / "s").string()},
+                                std::chrono::milliseconds(300)),
+            130);
+  EXPECT_LT(std::chrono::steady_clock::now() - interrupted, std::chrono::seconds(2));
+  EXPECT_FALSE(fs::exists(dir_ / "s"));
 }

@@ -411,6 +411,40 @@ TEST(Readers, BadLinesAreSkippedOnlyWhenAsked) {
   EXPECT_THROW(parseCarmenLog("FLASER x\n", "none.log", skip), InputError);
 }
 
+TEST(Readers, EachScanCarriesItsIpcTimestamp) {
+  // FLASER ... ipc_timestamp ipc_hostname logger_timestamp; ROBOTLASER1 ... timestamp host logger_timestamp.
+  const std::string flaser = "FLASER 2 1 1 0 0 0 0 0 0 1234.5 host 99\nFLASER 2 1 1 0 0 0 0 0 0 1234.75 host 98\n";
+  const CarmenLog front = parseCarmenLog(flaser, "f.log");
+  ASSERT_EQ(front.scans.size(), 2u);
+  EXPECT_DOUBLE_EQ(front.scans[0].timestamp, 1234.5);
+  EXPECT_DOUBLE_EQ(front.scans[1].timestamp, 1234.75);
+  const CarmenLog robot = parseCarmenLog(robotLaser(-kPi / 2, kPi, kPi / 2, 3, 5.0), "r.clf");
+  EXPECT_DOUBLE_EQ(robot.scans.at(0).timestamp, 1.0);
+  // A timestamp that is not a number: NaN for a grouping, which does not use
+  // it, an error naming file, line and field for a replay that does.
+  const std::string bad = "FLASER 2 1 1 0 0 0 0 0 0 soon host 99\n";
+  EXPECT_TRUE(std::isnan(parseCarmenLog(bad, "b.log").scans.at(0).timestamp));
+  CarmenOptions stamped;
+  stamped.require_timestamps = true;
+  EXPECT_DOUBLE_EQ(parseCarmenLog(flaser, "f.log", stamped).scans[1].timestamp, 1234.75);
+  try {
+    parseCarmenLog(flaser + bad, "b.log", stamped);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.log:3: field 'ipc_timestamp': 'soon' is not a number"), std::string::npos)
+        << e.what();
+  }
+  std::string robot_bad = robotLaser(-kPi / 2, kPi, kPi / 2, 3, 5.0);
+  robot_bad.replace(robot_bad.find(" 1.0 host"), 4, " nan");
+  try {
+    parseCarmenLog(robot_bad, "r.clf", stamped);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("r.clf:1: field 'timestamp': 'nan' is not finite"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Readers, APoseLineOfTheOtherFormatSaysWhichItIs) {
   try {
     parsePoses("1 0 0 5 0 1 0 6 0 0 1 7\n", "kitti.txt", PoseFormat::Tum);

@@ -224,6 +224,19 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   addRunOptions(command, args);
 }
 
+/// What `stream` adds: how often to update, and the replay's pace.
+void addStreamOptions(CLI::App& command, obsgroup::cli::StreamOptions& stream) {
+  command.add_option("--update-every", stream.update_every,
+                     "update the groups after every N observations inserted, and after the last")
+      ->check(wholeNumber(1))
+      ->capture_default_str()
+      ->group("Stream");
+  command.add_flag("--realtime", stream.realtime,
+                   "insert each observation at the time of its timestamp, as the robot sensed it (CARMEN logs, "
+                   "ROS bags)")
+      ->group("Stream");
+}
+
 /// CLI11's messages with the command's prefix, and where to read more.
 std::string failureMessage(const CLI::App* app, const CLI::Error& e) {
   std::string text = "obsgroup: error: " + std::string(e.what()) + "\n";
@@ -295,6 +308,13 @@ int main(int argc, char** argv) {
   obsgroup::cli::PartitionArgs args;
   CLI::App* partition = app.add_subcommand("partition", "group the observations of a laser log, a PCD sequence, depth images or KITTI scans");
   addPartitionOptions(*partition, args);
+  // stream binds the same options (only the command given parses any).
+  obsgroup::cli::StreamOptions stream_options;
+  CLI::App* stream = app.add_subcommand(
+      "stream", "replay the observations one at a time through the online grouping, printing each change of the "
+                "groups as it happens on stdout (-q: not); then write what partition writes");
+  addPartitionOptions(*stream, args);
+  addStreamOptions(*stream, stream_options);
 
   const auto usage = [](const std::string& message) {
     std::fprintf(stderr, "obsgroup: error: %s\n", message.c_str());
@@ -309,7 +329,9 @@ int main(int argc, char** argv) {
     app.exit(e);
     return 2;
   }
-  if (const auto error = settleOptions(*partition, args)) return usage(*error);
+  const bool streaming = stream->parsed();
+  if (const auto error = settleOptions(streaming ? *stream : *partition, args)) return usage(*error);
+  if (streaming) args.stream = stream_options;
 
   args.interrupt = &interrupt_requested;
   catchInterrupts();

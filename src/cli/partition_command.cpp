@@ -9,8 +9,10 @@
 #include "output_folder.h"
 #include <obsgroup/io/pcd_sequence.h>
 #include "pictures.h"
+#include "grouping_outcome.h"
 #include "progress_bar.h"
 #include "result_writers.h"
+#include "stream_grouping.h"
 #include "text_fields.h"
 
 #include <obsgroup/maps/local_map_builder.h>
@@ -40,6 +42,9 @@ struct InputRecord {
   nlohmann::json parameters;   ///< reader settings actually used
   std::vector<std::string> labels;  ///< where each observation came from, for messages
   std::vector<std::string> warnings;
+  /// When each observation was sensed, seconds (logs and bags; empty: the
+  /// format has none), for `stream --realtime`.
+  std::vector<double> stamps;
   double load_s = 0.0;
 };
 
@@ -120,14 +125,10 @@ std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& o
   return poses;
 }
 
-/// Groups the observations: the overlap, W and the partition (sec. II-III).
+/// The method's parameters, for the batch and the online grouping alike.
 template <typename PointT>
-Partition groupObservations(const PartitionArgs& args, ObservationGrouping<PointT>& grouping,
-                            const std::vector<Observation<PointT>>& observations, const InputRecord& input,
-                            Warnings& warn) {
-  throwIfInterrupted(args.interrupt);
+void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& grouping) {
   grouping.setInterruptFlag(args.interrupt);
-  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   grouping.setSensedSpaceModel(args.sso);
   grouping.setRegionParameters(args.region);
   grouping.setMatchDistance(args.delta);
@@ -138,25 +139,44 @@ Partition groupObservations(const PartitionArgs& args, ObservationGrouping<Point
   if (args.max_depth) grouping.setMaxDepth(*args.max_depth);
   grouping.setNumberOfThreads(args.threads);
   grouping.setKeepWorldPoints(args.pictures);  // map.png draws them
+}
+
+/// Groups the observations at once: the overlap, W and the partition (sec. II-III).
+template <typename PointT>
+void groupObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
+                       const InputRecord& input, GroupingOutcome<PointT>& out) {
+  ObservationGrouping<PointT>& grouping = out.grouping;
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   ProgressBar bar("overlap", !args.quiet);
   grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
-  Partition partition;
   try {
-    partition = grouping.compute();
+    out.partition = grouping.compute();
   } catch (const InvalidObservation& e) {
     throw io::InputError(input.labels[e.index()] + ": " + e.what());
   } catch (const std::invalid_argument& e) {
     throw io::InputError(args.input + ": " + e.what());
   }
   bar.finish();
-  // The core's warnings name observation indices; the user knows lines and
-  // files. The readers already warned about empty clouds.
-  const auto& points_per_observation = grouping.getOverlap().points_per_observation;
+  out.W = grouping.getWeightMatrix();
+  const auto& overlap = grouping.getOverlap();
+  out.points_per_observation = overlap.points_per_observation;
+  out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated},
+                    {"point_tests", overlap.point_tests},
+                    {"edges", overlap.pairs.size()}};
+  const auto& t = grouping.getTimings();
+  out.timing_s = {{"overlap", t.overlap_s}, {"graph", t.graph_s}, {"partition", t.partition_s}};
+}
+
+/// The grouping's warnings. The core's name observation indices; the user
+/// knows lines and files. The readers already warned about empty clouds.
+template <typename PointT>
+void warnAboutGrouping(const std::vector<Observation<PointT>>& observations, const InputRecord& input,
+                       const GroupingOutcome<PointT>& out, Warnings& warn) {
+  const auto& points_per_observation = out.points_per_observation;
   for (std::size_t i = 0; i < points_per_observation.size(); ++i)
     if (points_per_observation[i] == 0 && !observations[i].cloud->empty())
       warn(input.labels[i] + ": only NaN/Inf points; kept as a group of its own");
-  for (const auto& w : partition.warnings) warn(w);
-  return partition;
+  for (const auto& w : out.partition.warnings) warn(w);
 }
 
 template <typename PointT>
@@ -197,18 +217,18 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
 
 /// map.png/.svg, weights.png, fiedler.png and a picture per local map.
 template <typename PointT>
-void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const ObservationGrouping<PointT>& grouping,
-                  const std::vector<Observation<PointT>>& observations, const Partition& partition,
-                  const MapsOfRun<PointT>& maps) {
+void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
+                  const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
   // The points and regions as the grouping saw them, at the input poses;
   // map.png draws each observation at its refined pose.
-  const WorldPoints& world = grouping.getWorldPoints();
+  const WorldPoints& world = grouped.world();
+  const Partition& partition = grouped.partition;
   ObservationRegions regions;
   const bool tinted = args.sso != SensedSpaceModel::Points;
-  if (tinted) regions = grouping.getSensedSpaceOverlap().computeRegions(observations, world);
+  if (tinted) regions = grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, world);
   io::writeMapPictures(out, world, posesOf(observations), io::refinedPoses(maps.topology, observations.size()),
                        partition, maps.topology, tinted ? &regions : nullptr);
-  io::writeWeightsPicture(out, grouping.getWeightMatrix(), partition);
+  io::writeWeightsPicture(out, grouped.W, partition);
   io::writeFiedlerPicture(out, partition);
   io::writeLocalMapPictures(out, maps.maps, args.threads, io::groupColours(maps.topology));
 }
@@ -247,9 +267,8 @@ struct OutputTimes {
 };
 
 template <typename PointT>
-OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
-                         const ObservationGrouping<PointT>& grouping, const std::vector<Observation<PointT>>& observations,
-                         const Partition& partition, const MapsOfRun<PointT>& maps) {
+OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
+                         const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
   const auto start = Clock::now();
   OutputTimes t;
   t.map_points = io::writeLocalMaps(out, maps.maps, args.threads);
@@ -258,7 +277,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
   if (args.pictures) {
     const auto pictures_start = Clock::now();
-    drawPictures(args, out, grouping, observations, partition, maps);
+    drawPictures(args, out, grouped, observations, maps);
     t.pictures_s = secondsSince(pictures_start);
   }
   t.outputs_s = secondsSince(start);
@@ -267,63 +286,88 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
 
 /// What partition.json records besides the groups and the split tree.
 template <typename PointT>
-io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, const ObservationGrouping<PointT>& grouping,
-                        const Partition& partition, const MapsOfRun<PointT>& maps, const OutputTimes& written,
-                        const Warnings& warn) {
-  const auto& overlap = grouping.getOverlap();
+io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, const GroupingOutcome<PointT>& grouped,
+                        const MapsOfRun<PointT>& maps, const OutputTimes& written, const Warnings& warn) {
   std::size_t points = 0;
-  for (std::size_t m : overlap.points_per_observation) points += m;
+  for (std::size_t m : grouped.points_per_observation) points += m;
   io::RunRecord run;
   run.input = args.input;
   run.parameters = input.parameters;
   run.parameters["format"] = input.format;
-  run.parameters.update(methodParameters(args, grouping.getDiagonalWeight(), maps.voxel));
-  run.statistics = {{"points", points},
-                    {"pairs_evaluated", overlap.pairs_evaluated},
-                    {"point_tests", overlap.point_tests},
-                    {"edges", overlap.pairs.size()},
-                    {"groups", partition.groups.size()},
-                    {"local_map_points", written.map_points},
-                    {"refined_members", maps.refinement.moved},
-                    {"kept_members", maps.refinement.members - maps.refinement.moved}};
-  const auto& t = grouping.getTimings();
+  run.parameters.update(methodParameters(args, grouped.grouping.getDiagonalWeight(), maps.voxel));
+  run.parameters.update(grouped.parameters);
+  // Objects keep their keys sorted: the grouping's own entries fall in place.
+  run.statistics = grouped.statistics;
+  run.statistics.update({{"points", points},
+                         {"groups", grouped.partition.groups.size()},
+                         {"local_map_points", written.map_points},
+                         {"refined_members", maps.refinement.moved},
+                         {"kept_members", maps.refinement.members - maps.refinement.moved}});
   run.warnings = warn.all();
-  run.timing_s = {{"load", input.load_s},         {"overlap", t.overlap_s},     {"graph", t.graph_s},
-                  {"partition", t.partition_s}, {"local_maps", maps.seconds}, {"outputs", written.outputs_s},
-                  {"pictures", written.pictures_s}, {"threads", threadCount(args.threads)}};
+  run.timing_s = grouped.timing_s;
+  run.timing_s.update({{"load", input.load_s},
+                       {"local_maps", maps.seconds},
+                       {"outputs", written.outputs_s},
+                       {"pictures", written.pictures_s},
+                       {"threads", threadCount(args.threads)}});
   return run;
 }
 
+std::string plural(std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); }
+
+void printWritten(const PartitionArgs& args) {
+  std::fprintf(stderr, "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n", args.output.c_str(),
+               args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
+}
+
 void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
-  const auto plural = [](std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); };
   const auto& s = run.statistics;
   const auto& t = run.timing_s;
   std::fprintf(stderr,
                "obsgroup: %s (%s), %s evaluated, %zu overlapping, %s\n"
                "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
-               " (pictures %.2f s)\n"
-               "  wrote %s (partition.json, topology.json/.dot, local_maps/%s)\n",
+               " (pictures %.2f s)\n",
                plural(observations, "observation").c_str(), plural(s.at("points").get<std::size_t>(), "point").c_str(),
                plural(s.at("pairs_evaluated").get<std::size_t>(), "pair").c_str(), s.at("edges").get<std::size_t>(),
                plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(), t.at("overlap").get<double>(),
                t.at("graph").get<double>(), t.at("partition").get<double>(), t.at("local_maps").get<double>(),
-               t.at("outputs").get<double>(), t.at("pictures").get<double>(), args.output.c_str(),
-               args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
+               t.at("outputs").get<double>(), t.at("pictures").get<double>());
+  printWritten(args);
+}
+
+void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
+  const auto& s = run.statistics;
+  const auto& t = run.timing_s;
+  std::fprintf(stderr,
+               "obsgroup: %s (%s) streamed, %s, %zu overlapping, %s\n"
+               "  load %.2f s, stream %.2f s, local maps %.2f s, outputs %.2f s (pictures %.2f s)\n",
+               plural(observations, "observation").c_str(), plural(s.at("points").get<std::size_t>(), "point").c_str(),
+               plural(s.at("updates").get<std::size_t>(), "update").c_str(), s.at("edges").get<std::size_t>(),
+               plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(),
+               t.at("stream").get<double>(), t.at("local_maps").get<double>(), t.at("outputs").get<double>(),
+               t.at("pictures").get<double>());
+  printWritten(args);
 }
 
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
-  ObservationGrouping<PointT> grouping;
-  const Partition partition = groupObservations(args, grouping, observations, input, warn);
-  const MapsOfRun<PointT> maps = buildMaps(args, observations, partition, grouping.getWeightMatrix(), warn);
+  throwIfInterrupted(args.interrupt);
+  GroupingOutcome<PointT> grouped;
+  configureGrouping(args, grouped.grouping);
+  if (args.stream)
+    streamObservations(args, observations, input.labels, input.stamps, grouped);
+  else
+    groupObservations(args, observations, input, grouped);
+  warnAboutGrouping(observations, input, grouped, warn);
+  const MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.W, warn);
   io::OutputFolder out(args.output, args.force, args.interrupt);
-  const OutputTimes written = writeResults(args, out, grouping, observations, partition, maps);
-  const io::RunRecord run = runRecord(args, input, grouping, partition, maps, written, warn);
-  out.writeText("partition.json", io::partitionJson(partition, run));
+  const OutputTimes written = writeResults(args, out, grouped, observations, maps);
+  const io::RunRecord run = runRecord(args, input, grouped, maps, written, warn);
+  out.writeText("partition.json", io::partitionJson(grouped.partition, run));
   out.commit();
-  if (!args.quiet) printSummary(args, run, observations.size());
+  if (!args.quiet) (args.stream ? printStreamSummary : printSummary)(args, run, observations.size());
   return 0;
 }
 
@@ -335,6 +379,7 @@ int runCarmen(const PartitionArgs& args) {
   options.max_range = args.max_range;
   options.threads = args.threads;
   options.skip_bad_lines = args.skip_bad_lines;
+  options.require_timestamps = args.stream && args.stream->realtime;
   io::CarmenLog log = io::readCarmenLog(args.input, options);
   const std::string name = io::inputName(args.input);
   const int n = static_cast<int>(log.scans.size());
@@ -342,10 +387,12 @@ int runCarmen(const PartitionArgs& args) {
   InputRecord input;
   input.format = "carmen";
   input.labels.resize(n);
+  input.stamps.resize(n);
 #pragma omp parallel for schedule(dynamic, 64)
   for (int i = 0; i < n; ++i) {
     observations[i] = {io::scanToCloud(log.scans[i]), log.scans[i].laser_pose};
     input.labels[i] = name + ":" + std::to_string(log.scans[i].line);
+    input.stamps[i] = log.scans[i].timestamp;
   }
   // The beam geometry actually used (from the messages, PARAM lines or options), as read off the first scan.
   const io::LaserScan& first = log.scans.front();
@@ -476,6 +523,7 @@ int runBagAs(const PartitionArgs& args, const io::BagReader& reader, io::PointKi
   InputRecord input;
   input.format = io::toString(sequence.version);
   input.labels = std::move(sequence.labels);
+  input.stamps = std::move(sequence.stamps);
   input.parameters = {{"topic", sequence.topic},
                       {"message_type", sequence.message_type},
                       {"poses_from", sequence.pose_source},
@@ -519,6 +567,10 @@ int runPartition(const PartitionArgs& args) {
   if (args.threads > 0) omp_set_num_threads(args.threads);  // every parallel stage, the writers' too
   const std::string format = detectFormat(args);
   checkOptionsFit(args, format);
+  const bool stamped = format == "carmen" || format == "ros1" || format == "ros2";
+  if (args.stream && args.stream->realtime && !stamped)
+    throw io::UsageError("--realtime replays a CARMEN log or a ROS bag at its timestamps; " + args.input + " is " +
+                         format + ", a format with no timestamps");
   io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
   if (format == "carmen") return runCarmen(args);
   if (format == "tum-rgbd") return runDepth(args, io::DepthLayout::TumRgbd);

@@ -1,6 +1,7 @@
 #pragma once
 // `obsgroup partition INPUT -o OUTDIR`: read a log or a PCD sequence, group
-// its observations and write the results.
+// its observations and write the results. `obsgroup stream` does the same
+// through the online grouping, one observation at a time.
 
 #include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/io/depth_sequence.h>
@@ -15,6 +16,12 @@
 #include <vector>
 
 namespace obsgroup::cli {
+
+/// What `obsgroup stream` adds to partition's options.
+struct StreamOptions {
+  int update_every = 1;   ///< update the groups after every N inserts (and after the last)
+  bool realtime = false;  ///< insert each observation at its stamp's time (logs and bags)
+};
 
 struct PartitionArgs {
   std::string input;
@@ -64,10 +71,14 @@ struct PartitionArgs {
   /// Set (by a SIGINT/SIGTERM handler) to stop the run; the output folder is
   /// then left as it was.
   const InterruptFlag* interrupt = nullptr;
+  /// Set: `obsgroup stream` (the online grouping), not `partition`.
+  std::optional<StreamOptions> stream;
 };
 
 /// Runs the command; returns the exit code. Throws io::UsageError (exit 2),
 /// io::InputError (exit 3) and Interrupted.
+/// With args.stream, `obsgroup stream`: the same outputs, from the online
+/// grouping, and each change of the groups on stdout.
 int runPartition(const PartitionArgs& args);
 
 }  // namespace obsgroup::cli

@@ -474,6 +474,7 @@ void addObservations(const std::vector<Numbered<Message>>& messages, const std::
       sequence.observations.push_back({cloud, body_pose});
     }
     sequence.labels.push_back(label);
+    sequence.stamps.push_back(message.header.stamp);
   }
 }
 

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <thread>
 
@@ -67,8 +68,16 @@ Eigen::Isometry3d parsePose(const std::vector<std::string_view>& fields, std::si
   return pose2D(x, y, theta);
 }
 
+/// The message's ipc_timestamp (named `name` in errors): a finite number
+/// when `required`, else NaN when it is not a number.
+double readTimestamp(std::string_view field, const LineRef& where, const std::string& name, bool required) {
+  if (required) return parseFinite(field, where, name);
+  return toDouble(field).value_or(std::numeric_limits<double>::quiet_NaN());
+}
+
 /// FLASER/RLASER n r1..rn x y theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp
-LaserScan parseFrontOrRearLaser(const std::vector<std::string_view>& fields, const LineRef& where) {
+LaserScan parseFrontOrRearLaser(const std::vector<std::string_view>& fields, const LineRef& where,
+                                bool require_timestamp) {
   static const char* kTail[] = {"x", "y", "theta", "odom_x", "odom_y", "odom_theta",
                                 "ipc_timestamp", "ipc_hostname", "logger_timestamp"};
   if (fields.size() < 2)
@@ -80,6 +89,7 @@ LaserScan parseFrontOrRearLaser(const std::vector<std::string_view>& fields, con
   LaserScan scan;
   readRanges(fields, 2, n, where, scan);
   scan.laser_pose = parsePose(fields, 2 + n, where, "laser_pose");  // x y theta: the laser's pose
+  scan.timestamp = readTimestamp(fields[2 + n + 6], where, "ipc_timestamp", require_timestamp);
   return scan;
 }
 
@@ -104,7 +114,7 @@ double robotLaserStep(double fov, double resolution, long n, bool* disagrees) {
 /// remission_mode n r1..rn num_remissions [remissions] laser_pose_x laser_pose_y laser_pose_theta
 /// robot_pose_x robot_pose_y robot_pose_theta laser_tv laser_rv forward_safety_dist
 /// side_safety_dist turn_axis timestamp host logger_timestamp
-LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const LineRef& where) {
+LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const LineRef& where, bool require_timestamp) {
   static const char* kHead[] = {"ROBOTLASER1",        "laser_type",   "start_angle",   "field_of_view",
                                 "angular_resolution", "maximum_range", "accuracy",     "remission_mode",
                                 "num_readings"};
@@ -146,6 +156,7 @@ LaserScan parseRobotLaser(const std::vector<std::string_view>& fields, const Lin
   readRanges(fields, 9, n, where, scan);
   scan.laser_pose = parsePose(fields, tail, where, "laser_pose");
   scan.robot_pose = parsePose(fields, tail + 3, where, "robot_pose");
+  scan.timestamp = readTimestamp(fields[tail + 11], where, "timestamp", require_timestamp);
   return scan;
 }
 
@@ -298,7 +309,7 @@ struct ParsedSlice {
 bool isVertex(std::string_view message) { return message == "VERTEX2" || message == "VERTEX_SE2"; }
 
 void parseLine(std::string_view line, std::size_t line_number, const std::string& path, LaserSource source,
-               ParsedSlice& out) {
+               bool require_timestamps, ParsedSlice& out) {
   const auto fields = splitFields(line);
   if (fields.empty() || fields[0].front() == '#') return;
   const LineRef where{path, line_number};
@@ -311,8 +322,8 @@ void parseLine(std::string_view line, std::size_t line_number, const std::string
                            std::string(fields[0]));
     out.vertices.push_back({line_number, parsePose(fields, 2, where, "vertex")});
   } else if (fields[0] == messageName(source)) {
-    LaserScan scan = source == LaserSource::RobotLaser ? parseRobotLaser(fields, where)
-                                                       : parseFrontOrRearLaser(fields, where);
+    LaserScan scan = source == LaserSource::RobotLaser ? parseRobotLaser(fields, where, require_timestamps)
+                                                       : parseFrontOrRearLaser(fields, where, require_timestamps);
     if (source != LaserSource::RobotLaser) scan.robot_pose = scan.laser_pose;
     scan.line = line_number;
     out.scans.push_back(std::move(scan));
@@ -322,12 +333,12 @@ void parseLine(std::string_view line, std::size_t line_number, const std::string
 /// Parses lines [begin, end); throws the first bad line's error, or records
 /// it and goes on when `skip_bad_lines`.
 void parseSlice(const NumberedLines& lines, std::size_t begin, std::size_t end, const std::string& path,
-                LaserSource source, bool skip_bad_lines, ParsedSlice& out) {
+                LaserSource source, const CarmenOptions& options, ParsedSlice& out) {
   for (std::size_t k = begin; k < end; ++k) {
     try {
-      parseLine(lines[k].second, lines[k].first, path, source, out);
+      parseLine(lines[k].second, lines[k].first, path, source, options.require_timestamps, out);
     } catch (const InputError& e) {
-      if (!skip_bad_lines) throw;
+      if (!options.skip_bad_lines) throw;
       out.bad_lines.push_back(e.what());
     }
   }
@@ -345,12 +356,11 @@ int threadsFor(std::size_t bytes, const CarmenOptions& options) {
 /// are in line order, so the result (and the error of the first bad line)
 /// does not depend on the thread count.
 std::vector<ParsedSlice> parseSlices(const NumberedLines& lines, const std::string& path, LaserSource source,
-                                     bool skip_bad_lines, int threads) {
+                                     const CarmenOptions& options, int threads) {
   const std::size_t count = std::max<std::size_t>(1, std::min<std::size_t>(threads, lines.size()));
   std::vector<ParsedSlice> slices(count);
   parallelFor(count, threads, [&](std::size_t t) {
-    parseSlice(lines, lines.size() * t / count, lines.size() * (t + 1) / count, path, source, skip_bad_lines,
-               slices[t]);
+    parseSlice(lines, lines.size() * t / count, lines.size() * (t + 1) / count, path, source, options, slices[t]);
   });
   return slices;
 }
@@ -455,7 +465,7 @@ CarmenLog parseText(std::string_view content, const std::string& path, const Car
   log.source = chooseSource(lines.counts, options, path, log.warnings);
   // Second pass: the lines in slices, in parallel.
   std::vector<ParsedSlice> slices =
-      parseSlices(lines.lines, path, log.source, options.skip_bad_lines, threadsFor(content.size(), options));
+      parseSlices(lines.lines, path, log.source, options, threadsFor(content.size(), options));
   lines = {};
   LaserParams params;
   std::vector<Vertex> vertices;

@@ -8,6 +8,7 @@
 
 #include <pcl/point_types.h>
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -42,6 +43,10 @@ struct CarmenOptions {
   /// A bad line of a read message (laser, PARAM, VERTEX2) is skipped, and
   /// counted in one warning, instead of being an error.
   bool skip_bad_lines = false;
+  /// Each scan's timestamp must be a finite number (a replay at the log's
+  /// pace needs it): otherwise an error naming file, line and field. Without
+  /// it a timestamp that is not a number is NaN, as a grouping does not use it.
+  bool require_timestamps = false;
 };
 
 /// One scan: ranges and beam geometry in the laser frame (x ahead, y left),
@@ -57,6 +62,9 @@ struct LaserScan {
   double field_of_view = 0.0;   ///< radians, as the message (or PARAM, option) says
   bool step_disagrees = false;  ///< ROBOTLASER1: fov and resolution disagree; spaced by the resolution
   std::size_t line = 0;  ///< line of the log it came from
+  /// When the message was sent, seconds: its ipc_timestamp (the third field
+  /// from the end); NaN when that is not a number (see require_timestamps).
+  double timestamp = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct CarmenLog {

@@ -48,6 +48,7 @@ struct BagSequenceOf {
   BagVersion version = BagVersion::Ros1;
   std::vector<Observation<PointT>> observations;  ///< points in the sensor frame, posed in the fixed frame
   std::vector<std::string> labels;  ///< "BAG: message N on TOPIC" of each observation
+  std::vector<double> stamps;       ///< header stamp of each observation's message, seconds
   std::vector<std::string> warnings;
   std::string topic;         ///< the data topic read
   std::string message_type;  ///< sensor_msgs/LaserScan or sensor_msgs/PointCloud2

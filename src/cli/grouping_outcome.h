@@ -1,0 +1,38 @@
+#pragma once
+// What the steps after grouping (local maps, pictures, partition.json) take
+// from a grouping, so that `partition` (ObservationGrouping::compute) and
+// `stream` (OnlineGrouping, one update per insert) share them.
+
+#include <obsgroup/observation_grouping.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <vector>
+
+namespace obsgroup::cli {
+
+template <typename PointT>
+struct GroupingOutcome {
+  /// The method's parameters (both modes set them here; `stream` copies them
+  /// into its OnlineGrouping). After a batch run, also its results.
+  ObservationGrouping<PointT> grouping;
+  Partition partition;
+  WeightMatrix W;
+  /// Points of each observation after filtering, as the overlap counts them.
+  std::vector<std::size_t> points_per_observation;
+  /// The observations' points in the common frame for the pictures: the
+  /// batch's own (setKeepWorldPoints), or the stream's (SensedSpaceOverlap::toWorld).
+  WorldPoints stream_world;
+  bool online = false;
+  /// pairs_evaluated, point_tests, edges, and what else the mode measures.
+  nlohmann::json statistics = nlohmann::json::object();
+  /// Seconds of the grouping's own stages.
+  nlohmann::json timing_s = nlohmann::json::object();
+  /// What partition.json records of the mode besides the method's parameters.
+  nlohmann::json parameters = nlohmann::json::object();
+
+  const WorldPoints& world() const { return online ? stream_world : grouping.getWorldPoints(); }
+};
+
+}  // namespace obsgroup::cli

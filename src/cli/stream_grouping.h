@@ -1,0 +1,188 @@
+#pragma once
+// The online half of `obsgroup stream`: the observations inserted one at a
+// time into an OnlineGrouping, the groups updated every N inserts and each
+// change printed as it happens, optionally at the pace of the log's stamps.
+
+#include "grouping_outcome.h"
+#include "partition_command.h"
+
+#include <obsgroup/common/invalid_observation.h>
+#include <obsgroup/common/parallel_for.h>
+#include <obsgroup/io/errors.h>
+#include <obsgroup/online_grouping.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace obsgroup::cli {
+
+/// "group 7 grown (12 observations)", "group 3 split into 3 9", ...
+inline std::string describeChange(const GroupChange& change) {
+  std::string text = "group " + std::to_string(change.group) + " " + toString(change.kind);
+  if (change.kind == GroupChange::Kind::Split || change.kind == GroupChange::Kind::Merged) {
+    text += change.kind == GroupChange::Kind::Split ? " into" : " from";
+    for (int g : change.related) text += " " + std::to_string(g);
+  }
+  const std::size_t n = change.members.size();
+  if (n > 0) text += " (" + std::to_string(n) + " observation" + (n == 1 ? "" : "s") + ")";
+  return text;
+}
+
+/// Paces a replay at the input's stamps: observation k is due at
+/// t0 + (stamp_k - stamp_0) wall time, t0 being when observation 0 came.
+/// The schedule is absolute, so a slow update is caught up on, and a stamp
+/// that goes backwards is already due: it is not slept on.
+class ReplayClock {
+ public:
+  using Clock = std::chrono::steady_clock;
+  /// `stamps` null: no pacing.
+  ReplayClock(const std::vector<double>* stamps, const InterruptFlag* interrupt)
+      : stamps_(stamps), interrupt_(interrupt) {}
+
+  void waitFor(std::size_t k) {
+    if (!stamps_) return;
+    if (k == 0) start_ = Clock::now();
+    const auto due = start_ + std::chrono::duration_cast<Clock::duration>(
+                                  std::chrono::duration<double>((*stamps_)[k] - (*stamps_)[0]));
+    const auto before = Clock::now();
+    // Short naps, so that Ctrl-C stops a replay waiting for a late stamp.
+    for (auto now = before; now < due; now = Clock::now()) {
+      throwIfInterrupted(interrupt_);
+      std::this_thread::sleep_for(std::min<Clock::duration>(due - now, std::chrono::milliseconds(50)));
+    }
+    waited_s_ += std::chrono::duration<double>(Clock::now() - before).count();
+  }
+  double waitedSeconds() const { return waited_s_; }
+
+ private:
+  const std::vector<double>* stamps_;
+  const InterruptFlag* interrupt_;
+  Clock::time_point start_;
+  double waited_s_ = 0.0;
+};
+
+/// Each observation's points after filtering, as the batch overlap counts
+/// them (SensedSpaceOverlap::toWorld), without keeping them.
+template <typename PointT>
+std::vector<std::size_t> filteredPointCounts(const SensedSpaceOverlap<PointT>& overlap,
+                                             const std::vector<Observation<PointT>>& observations, int threads) {
+  std::vector<std::size_t> counts(observations.size(), 0);
+  if (observations.empty()) return counts;
+  const Eigen::Vector3d origin = observations.front().pose.translation();  // toWorld's, as the voxel grid depends on it
+  parallelFor(observations.size(), threads, 4, [&](std::size_t i) {
+    counts[i] = overlap.observationToWorld(observations[i], origin).size();
+  });
+  return counts;
+}
+
+/// The points the outputs need, as the batch keeps them: all of them for
+/// the pictures, else only how many each observation has (the statistics).
+template <typename PointT>
+void addWorldPoints(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
+                    GroupingOutcome<PointT>& out) {
+  const SensedSpaceOverlap<PointT>& overlap = out.grouping.getSensedSpaceOverlap();
+  if (!args.pictures) {
+    out.points_per_observation = filteredPointCounts(overlap, observations, args.threads);
+    return;
+  }
+  out.stream_world = overlap.toWorld(observations);
+  for (int i = 0; i < out.stream_world.size(); ++i) out.points_per_observation.push_back(out.stream_world.count(i));
+}
+
+/// Edges of W: the pairs i < j that overlap (the batch's OverlapResult::pairs).
+inline std::size_t edgeCount(const WeightMatrix& W) {
+  std::size_t edges = 0;
+  for (int j = 0; j < W.outerSize(); ++j)
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
+      if (it.row() < it.col() && it.value() > 0) ++edges;
+  return edges;
+}
+
+/// What the updates of a stream did, summed.
+struct StreamTotals {
+  std::size_t updates = 0, observations_recomputed = 0, split_nodes_reused = 0, split_nodes_computed = 0;
+  double online_s = 0.0;  ///< inserts and updates, waits excluded
+};
+
+/// One update, its changes printed on stdout (named after the observation
+/// just inserted), unless quiet.
+template <typename PointT>
+void updateAndPrint(OnlineGrouping<PointT>& online, int last_id, bool quiet, StreamTotals& totals) {
+  const GroupUpdate update = online.update();
+  ++totals.updates;
+  totals.observations_recomputed += update.observations_recomputed;
+  totals.split_nodes_reused += update.split_nodes_reused;
+  totals.split_nodes_computed += update.split_nodes_computed;
+  if (quiet) return;
+  for (const GroupChange& change : update.changes)
+    std::printf("observation %d: %s\n", last_id, describeChange(change).c_str());
+  std::fflush(stdout);  // seen as it happens, on a pipe too
+}
+
+/// Inserts every observation in input order, updating every `update_every`
+/// inserts and after the last. Throws io::InputError naming the input line
+/// of an observation the online grouping refuses, as `partition` does.
+template <typename PointT>
+StreamTotals replay(const PartitionArgs& args, OnlineGrouping<PointT>& online,
+                    const std::vector<Observation<PointT>>& observations, const std::vector<std::string>& labels,
+                    ReplayClock& clock) {
+  StreamTotals totals;
+  const std::size_t every = static_cast<std::size_t>(args.stream->update_every);
+  for (std::size_t k = 0; k < observations.size(); ++k) {
+    clock.waitFor(k);
+    const auto start = ReplayClock::Clock::now();
+    throwIfInterrupted(args.interrupt);
+    try {
+      const int id = online.insert(observations[k].cloud, observations[k].pose);
+      if ((k + 1) % every == 0 || k + 1 == observations.size()) updateAndPrint(online, id, args.quiet, totals);
+    } catch (const InvalidObservation& e) {
+      throw io::InputError(labels.at(e.index()) + ": " + e.what());  // ids are input positions: none is removed
+    } catch (const std::invalid_argument& e) {
+      throw io::InputError(args.input + ": " + e.what());
+    }
+    totals.online_s += std::chrono::duration<double>(ReplayClock::Clock::now() - start).count();
+  }
+  return totals;
+}
+
+/// Groups the observations online; the result is the batch's (OnlineGrouping
+/// is exact), with the statistics the online run measures.
+template <typename PointT>
+void streamObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
+                        const std::vector<std::string>& labels, const std::vector<double>& stamps,
+                        GroupingOutcome<PointT>& out) {
+  OnlineGrouping<PointT> online;
+  online.setParametersFrom(out.grouping);
+  online.setNumberOfThreads(args.threads);
+  online.setInterruptFlag(args.interrupt);
+  ReplayClock clock(args.stream->realtime ? &stamps : nullptr, args.interrupt);
+  const StreamTotals totals = replay(args, online, observations, labels, clock);
+  out.online = true;
+  out.partition = online.getPartition();
+  out.W = online.getWeightMatrix();
+  const auto start = ReplayClock::Clock::now();
+  addWorldPoints(args, observations, out);
+  const std::size_t edges = edgeCount(out.W);
+  // The online overlap counts neither the pairs it tests nor the point
+  // tests: pairs_evaluated is the edges (each was evaluated at least once),
+  // point_tests 0 (not counted); the rest is measured.
+  out.statistics = {{"pairs_evaluated", edges},
+                    {"point_tests", 0},
+                    {"edges", edges},
+                    {"updates", totals.updates},
+                    {"observations_recomputed", totals.observations_recomputed},
+                    {"split_nodes_reused", totals.split_nodes_reused},
+                    {"split_nodes_computed", totals.split_nodes_computed}};
+  const double world_s = std::chrono::duration<double>(ReplayClock::Clock::now() - start).count();
+  out.timing_s = {{"stream", totals.online_s}, {"world_points", world_s}};
+  if (args.stream->realtime) out.timing_s["realtime_wait"] = clock.waitedSeconds();
+  out.parameters = {{"mode", "stream"},
+                    {"update_every", args.stream->update_every},
+                    {"realtime", args.stream->realtime}};
+}
+
+}  // namespace obsgroup::cli
