@@ -2,18 +2,22 @@
 // building of bench/make_scaling_input (2D laser of 360 beams, or a depth
 // camera of 160 x 120 points), generated in memory.
 //
-//   online_latency 2d|3d N [--sample K] [--update-every U] [--threads T]
+//   online_latency 2d|3d N [--sample K] [--update-every U] [--exact-every E] [--check C] [--threads T]
 //
 // Without --sample, every observation is inserted and timed (a full replay),
 // and the batch ObservationGrouping::compute() on the same N is timed too.
 // With --sample K, the first N - K observations are inserted and grouped
 // once, untimed, and only the last K inserts are timed: the latency at size
-// N without replaying N. Prints one markdown row: median, 99th percentile and
-// worst latency, the overlaps and split-tree nodes recomputed per update, and
-// (full replay) the replay and batch times. Results are checked: the final
-// groups must equal the batch's.
+// N without replaying N. --exact-every E makes updates local between exact
+// ones (OnlineGrouping::setExactInterval); --check C then compares the
+// groups after every C-th insert with a batch compute() (adjusted Rand
+// index, untimed). Prints one markdown row: median, 99th percentile and
+// worst latency, the overlaps and split-tree nodes recomputed per update,
+// (full replay) the replay and batch times, and the lowest ARI seen. The
+// final groups, after an exact update, must equal the batch's.
 
 #include "floor_plan.h"
+#include "scenarios.h"
 #include "to_cloud.h"
 
 #include <obsgroup/online_grouping.h>
@@ -81,12 +85,14 @@ int main(int argc, char** argv) {
   }
   const std::string kind = argv[1];
   const int n = std::atoi(argv[2]);
-  int sample = 0, every = 1, threads = 0;
+  int sample = 0, every = 1, threads = 0, exact_every = 1, check = 0;
   for (int a = 3; a + 1 < argc; a += 2) {
     const std::string option = argv[a];
     if (option == "--sample") sample = std::atoi(argv[a + 1]);
     else if (option == "--update-every") every = std::max(1, std::atoi(argv[a + 1]));
     else if (option == "--threads") threads = std::atoi(argv[a + 1]);
+    else if (option == "--exact-every") exact_every = std::atoi(argv[a + 1]);
+    else if (option == "--check") check = std::atoi(argv[a + 1]);
   }
   if ((kind != "2d" && kind != "3d") || n < 2 || sample < 0 || sample >= n) {
     std::fprintf(stderr, "online_latency: bad arguments\n");
@@ -96,24 +102,35 @@ int main(int argc, char** argv) {
 
   OnlineGrouping<pcl::PointXYZ> online;
   online.setNumberOfThreads(threads);
+  online.setExactInterval(exact_every);
   const int untimed = sample > 0 ? n - sample : 0;
   for (int k = 0; k < untimed; ++k) online.insert(input[k].cloud, input[k].pose);
   if (untimed > 0) online.update();
   std::vector<double> latency;
   std::size_t recomputed = 0, computed_nodes = 0, updates = 0;
+  double checking_s = 0.0, lowest_ari = 1.0;
   const auto replay = Clock::now();
   for (int k = untimed; k < n; ++k) {
     const auto start = Clock::now();
     online.insert(input[k].cloud, input[k].pose);
     if ((k - untimed + 1) % every == 0 || k + 1 == n) {
-      const GroupUpdate u = online.update();
+      const GroupUpdate u = k + 1 == n ? online.updateExact() : online.update();
       recomputed += u.observations_recomputed;
       computed_nodes += u.split_nodes_computed;
       ++updates;
     }
     latency.push_back(seconds(start) * 1e3);
+    if (check > 0 && (k + 1) % check == 0 && k + 1 < n) {
+      const auto check_start = Clock::now();
+      ObservationGrouping<pcl::PointXYZ> reference;
+      reference.setNumberOfThreads(threads);
+      for (int i = 0; i <= k; ++i) reference.addObservation(input[i].cloud, input[i].pose);
+      lowest_ari = std::min(lowest_ari, sim::adjustedRandIndex(reference.compute().group_of,
+                                                                 online.getPartition().group_of));
+      checking_s += seconds(check_start);
+    }
   }
-  const double replay_s = seconds(replay);
+  const double replay_s = seconds(replay) - checking_s;
 
   double batch_s = 0.0;
   ObservationGrouping<pcl::PointXYZ> batch;
@@ -124,11 +141,11 @@ int main(int argc, char** argv) {
   batch_s = seconds(batch_start);
   const bool equal = expected.groups == online.getPartition().groups;
 
-  std::printf("| %s | %d | %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.2f | %s |\n",
+  std::printf("| %s | %d | %s | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %s | %.2f | %s | %s |\n",
               kind == "2d" ? "2D laser" : "depth camera", n, sample > 0 ? ("last " + std::to_string(sample)).c_str() : "all",
-              every, percentile(latency, 0.5), percentile(latency, 0.99), percentile(latency, 1.0),
+              every, exact_every, percentile(latency, 0.5), percentile(latency, 0.99), percentile(latency, 1.0),
               double(recomputed) / double(updates), double(computed_nodes) / double(updates),
               sample > 0 ? "-" : (std::to_string(replay_s).substr(0, 6) + " s").c_str(), batch_s,
-              equal ? "yes" : "NO");
+              check > 0 ? std::to_string(lowest_ari).substr(0, 5).c_str() : "-", equal ? "yes" : "NO");
   return equal ? 0 : 1;
 }

@@ -1312,6 +1312,12 @@ TEST_F(Cli, StreamGivesTheGroupsOfPartitionAndPrintsEachChange) {
   const nlohmann::json ten = readJson(dir_ / "ten" / "partition.json");
   EXPECT_EQ(ten.at("statistics").at("updates"), 8);  // after 10, 20, ..., 70 and the last (77)
   EXPECT_EQ(ten.at("parameters").at("update_every"), 10);
+
+  // Local updates in between: the last update is exact, so the groups are still partition's.
+  const Result local = run("stream " + input + " -q --no-pictures --exact-every 20 -o " + (dir_ / "local").string());
+  ASSERT_EQ(local.code, 0) << local.err;
+  EXPECT_EQ(groupsText(dir_ / "local"), groupsText(dir_ / "batch"));
+  EXPECT_EQ(readJson(dir_ / "local" / "partition.json").at("parameters").at("exact_every"), 20);
 }
 
 TEST_F(Cli, StreamOptionsAndErrors) {
@@ -1319,9 +1325,11 @@ TEST_F(Cli, StreamOptionsAndErrors) {
   EXPECT_NE(run("--help").out.find("stream"), std::string::npos);
   const Result help = run("stream --help");
   EXPECT_EQ(help.code, 0);
-  for (const char* option : {"--update-every", "--realtime", "--refine", "--no-pictures", "--threads", "--quiet"})
+  for (const char* option :
+       {"--update-every", "--exact-every", "--realtime", "--refine", "--no-pictures", "--threads", "--quiet"})
     EXPECT_NE(help.out.find(option), std::string::npos) << option;
   EXPECT_EQ(run("stream " + input + " --update-every 0 -o " + (dir_ / "o").string()).code, 2);
+  EXPECT_EQ(run("stream " + input + " --exact-every 0 -o " + (dir_ / "o").string()).code, 2);
   // A PCD sequence has no timestamps to replay at.
   const Result pcd = run("stream " + kData + "/office_3d/pcd --realtime -o " + (dir_ / "o").string());
   EXPECT_EQ(pcd.code, 2);

@@ -57,7 +57,9 @@ void expectEqualsBatch(const OnlineGrouping<pcl::PointXYZ>& online, ObservationG
   ASSERT_EQ(online.getPartition().splits.size(), expected.splits.size());
   for (std::size_t s = 0; s < expected.splits.size(); ++s) {
     EXPECT_EQ(online.getPartition().splits[s].members, expected.splits[s].members);
-    if (std::isfinite(expected.splits[s].ncut)) EXPECT_EQ(online.getPartition().splits[s].ncut, expected.splits[s].ncut);
+    if (std::isfinite(expected.splits[s].ncut)) {
+      EXPECT_EQ(online.getPartition().splits[s].ncut, expected.splits[s].ncut);
+    }
   }
   // The id view agrees with the position view.
   const std::vector<int> ids = online.getIds();
@@ -213,6 +215,33 @@ TEST(OnlineGrouping, LoopClosureRepartitionsOnlyTheGroupsItTouches) {
                       << update.split_nodes_computed << " of " << online.getPartition().splits.size()
                       << " split nodes computed";
   expectEqualsBatch(online, batchLike(SensedSpaceModel::Points), "loop closure");
+}
+
+TEST(OnlineGrouping, LocalUpdatesBetweenExactOnes) {
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setExactInterval(10);
+  int exact = 0;
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    online.insert(obs[k].cloud, obs[k].pose);
+    const GroupUpdate update = online.update();
+    // Every observation in exactly one group, whatever the mode.
+    std::vector<int> seen;
+    for (const auto& [group, members] : online.getGroups()) seen.insert(seen.end(), members.begin(), members.end());
+    std::sort(seen.begin(), seen.end());
+    EXPECT_EQ(seen, online.getIds());
+    ASSERT_EQ(online.getPartition().group_of.size(), k + 1);
+    if (update.exact) {
+      ++exact;
+      expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "exact update " + std::to_string(k));
+    } else {
+      EXPECT_TRUE(online.getPartition().splits.empty());
+    }
+  }
+  EXPECT_EQ(exact, 1 + 76 / 10);  // the first update, then every 10 inserts
+  const GroupUpdate last = online.updateExact();
+  EXPECT_TRUE(last.exact);
+  expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "updateExact");
 }
 
 TEST(OnlineGrouping, SameResultWhateverTheThreadCount) {

@@ -44,6 +44,9 @@ inline std::string toString(GroupChange::Kind kind) { return nameOf(kGroupChange
 /// What one OnlineGrouping::update() did.
 struct GroupUpdate {
   std::vector<GroupChange> changes;  ///< Split and Merged first, then the rest, each by group id.
+  /// True when the partition was computed exactly (equal to compute()); false
+  /// for a local update (OnlineGrouping::setExactInterval).
+  bool exact = true;
   std::size_t observations_recomputed = 0;  ///< Observations whose overlaps were recomputed.
   std::size_t split_nodes_reused = 0;       ///< Nodes of the split tree copied from the last update.
   std::size_t split_nodes_computed = 0;     ///< Nodes solved anew.
@@ -95,6 +98,19 @@ class OnlineGrouping {
   void remove(int id);
   /// Brings the groups up to date with every change since the last update().
   GroupUpdate update();
+  /// update(), exact whatever setExactInterval says.
+  GroupUpdate updateExact();
+
+  /// An approximation for speed, off by default (1: every update() is
+  /// exact). With n > 1, update() re-partitions only the groups that hold a
+  /// changed observation, the new observations and the groups next to them
+  /// in W, and leaves the other groups as they are; it is exact again once n
+  /// observations were inserted or moved since the last exact update. The
+  /// overlaps (W) stay exact. A local update's partition has no split tree
+  /// (Partition::splits is empty). docs/performance.md measures how far its
+  /// groups drift from the exact ones.
+  void setExactInterval(int n) { exact_interval_ = n < 1 ? 1 : n; }
+  int getExactInterval() const { return exact_interval_; }
 
   /// Ids of the observations present, ascending.
   std::vector<int> getIds() const;
@@ -151,6 +167,9 @@ class OnlineGrouping {
                                              const Eigen::Vector3d& origin) const;
   void recentreAll();
   void assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out);
+  std::vector<std::vector<int>> partitionExactly(const std::vector<int>& ids, GroupUpdate& out);
+  std::vector<std::vector<int>> partitionLocally(const std::vector<int>& ids, const std::vector<int>& changed_slots);
+  GroupUpdate run(bool force_exact);
 
   std::vector<Slot> slots_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // the first present observation's position
@@ -166,6 +185,10 @@ class OnlineGrouping {
   std::vector<int> group_of_;  // by id
   int next_group_id_ = 0;
   std::vector<std::string> warnings_;
+  int exact_interval_ = 1;
+  int changes_since_exact_ = 0;       // observations inserted or moved since the last exact update
+  std::vector<char> pending_;         // by id: row changed since the last exact update
+  bool exact_once_ = false;           // an exact update has been made (the cache holds its tree)
 };
 
 }  // namespace obsgroup

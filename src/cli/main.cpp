@@ -231,6 +231,12 @@ void addStreamOptions(CLI::App& command, obsgroup::cli::StreamOptions& stream) {
       ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Stream");
+  command.add_option("--exact-every", stream.exact_every,
+                     "faster, approximate: between exact updates, re-partition only the groups a change touches "
+                     "and their neighbours; exact again after N observations and at the end (1 = always exact)")
+      ->check(wholeNumber(1))
+      ->capture_default_str()
+      ->group("Stream");
   command.add_flag("--realtime", stream.realtime,
                    "insert each observation at the time of its timestamp, as the robot sensed it (CARMEN logs, "
                    "ROS bags)")

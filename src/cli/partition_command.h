@@ -20,6 +20,9 @@ namespace obsgroup::cli {
 /// What `obsgroup stream` adds to partition's options.
 struct StreamOptions {
   int update_every = 1;   ///< update the groups after every N inserts (and after the last)
+  /// Local updates in between, exact once N observations came since the
+  /// last exact one (OnlineGrouping::setExactInterval); 1: always exact.
+  int exact_every = 1;
   bool realtime = false;  ///< insert each observation at its stamp's time (logs and bags)
 };
 

@@ -111,8 +111,9 @@ struct StreamTotals {
 /// One update, its changes printed on stdout (named after the observation
 /// just inserted), unless quiet.
 template <typename PointT>
-void updateAndPrint(OnlineGrouping<PointT>& online, int last_id, bool quiet, StreamTotals& totals) {
-  const GroupUpdate update = online.update();
+void updateAndPrint(OnlineGrouping<PointT>& online, int last_id, bool last, bool quiet, StreamTotals& totals) {
+  // The last update is exact whatever --exact-every says: the outputs are the batch's.
+  const GroupUpdate update = last ? online.updateExact() : online.update();
   ++totals.updates;
   totals.observations_recomputed += update.observations_recomputed;
   totals.split_nodes_reused += update.split_nodes_reused;
@@ -138,7 +139,8 @@ StreamTotals replay(const PartitionArgs& args, OnlineGrouping<PointT>& online,
     throwIfInterrupted(args.interrupt);
     try {
       const int id = online.insert(observations[k].cloud, observations[k].pose);
-      if ((k + 1) % every == 0 || k + 1 == observations.size()) updateAndPrint(online, id, args.quiet, totals);
+      const bool last = k + 1 == observations.size();
+      if ((k + 1) % every == 0 || last) updateAndPrint(online, id, last, args.quiet, totals);
     } catch (const InvalidObservation& e) {
       throw io::InputError(labels.at(e.index()) + ": " + e.what());  // ids are input positions: none is removed
     } catch (const std::invalid_argument& e) {
@@ -159,6 +161,7 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
   online.setParametersFrom(out.grouping);
   online.setNumberOfThreads(args.threads);
   online.setInterruptFlag(args.interrupt);
+  online.setExactInterval(args.stream->exact_every);
   ReplayClock clock(args.stream->realtime ? &stamps : nullptr, args.interrupt);
   const StreamTotals totals = replay(args, online, observations, labels, clock);
   out.online = true;
@@ -182,6 +185,7 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
   if (args.stream->realtime) out.timing_s["realtime_wait"] = clock.waitedSeconds();
   out.parameters = {{"mode", "stream"},
                     {"update_every", args.stream->update_every},
+                    {"exact_every", args.stream->exact_every},
                     {"realtime", args.stream->realtime}};
 }
 

@@ -6,6 +6,7 @@
 #include "obsgroup/overlap/impl/sensed_space_overlap.hpp"
 
 #include <algorithm>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -87,6 +88,7 @@ int OnlineGrouping<PointT>::insert(const PointCloudConstPtr& cloud, const Eigen:
   }
   slots_.push_back({true, observation});
   group_of_.push_back(-1);
+  ++changes_since_exact_;
   origin_ = origin;
   if (overlap_ && !reconfigure_) overlap_->set(id, std::move(points), pose.translation() - origin);
   return id;
@@ -98,6 +100,7 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
   if (!pose.matrix().allFinite()) throw InvalidObservation(id, "pose is not finite");
   Observation<PointT> moved = slots_[id].observation;
   moved.pose = pose;
+  ++changes_since_exact_;
   if (id == firstPresent()) {
     // The common frame moves with it: every observation is re-centred.
     const Observation<PointT> kept = slots_[id].observation;
@@ -164,8 +167,19 @@ void OnlineGrouping<PointT>::recentreAll() {
 
 template <typename PointT>
 GroupUpdate OnlineGrouping<PointT>::update() {
+  return run(false);
+}
+
+template <typename PointT>
+GroupUpdate OnlineGrouping<PointT>::updateExact() {
+  return run(true);
+}
+
+template <typename PointT>
+GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   if (reconfigure_ || !overlap_) {
     cache_.clear();
+    exact_once_ = false;
     recentreAll();
   }
   GroupUpdate out;
@@ -173,12 +187,11 @@ GroupUpdate OnlineGrouping<PointT>::update() {
   out.observations_recomputed = overlap_->recomputedLastUpdate();
   const std::vector<int> ids = overlap_->slots();
   W_ = overlap_->weightMatrix(diagonal_);
-  std::vector<char> changed(ids.size(), 0);
-  for (int slot : changed_slots)
-    changed[std::lower_bound(ids.begin(), ids.end(), slot) - ids.begin()] = 1;
-  partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, cache_);
-  out.split_nodes_reused = cache_.reusedNodes();
-  out.split_nodes_computed = cache_.computedNodes();
+  pending_.resize(slots_.size(), 0);
+  for (int slot : changed_slots) pending_[slot] = 1;
+  out.exact = force_exact || !exact_once_ || exact_interval_ <= 1 || changes_since_exact_ >= exact_interval_;
+  const std::vector<std::vector<int>> groups =
+      out.exact ? partitionExactly(ids, out) : partitionLocally(ids, changed_slots);
 
   warnings_.clear();
   for (int id : ids)
@@ -186,15 +199,87 @@ GroupUpdate OnlineGrouping<PointT>::update() {
       warnings_.push_back("observation " + std::to_string(id) +
                           " has no finite point: it overlaps nothing and forms a group of its own");
   warnings_.insert(warnings_.end(), partition_.warnings.begin(), partition_.warnings.end());
+  assignGroupIds(groups, out);
+  return out;
+}
 
+/// The exact partition, reusing the split-tree nodes no changed row reaches.
+template <typename PointT>
+std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std::vector<int>& ids, GroupUpdate& out) {
+  std::vector<char> changed(ids.size(), 0);
+  for (std::size_t k = 0; k < ids.size(); ++k) changed[k] = pending_[ids[k]];
+  partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, cache_);
+  out.split_nodes_reused = cache_.reusedNodes();
+  out.split_nodes_computed = cache_.computedNodes();
+  std::fill(pending_.begin(), pending_.end(), 0);
+  changes_since_exact_ = 0;
+  exact_once_ = true;
   std::vector<std::vector<int>> groups;
   for (const auto& group : partition_.groups) {
     std::vector<int> members;
     for (int k : group) members.push_back(ids[k]);
     groups.push_back(std::move(members));
   }
-  assignGroupIds(groups, out);
-  return out;
+  return groups;
+}
+
+/// The groups holding a changed observation, the new observations and the
+/// groups next to them in W, re-partitioned on their own; the other groups
+/// kept (setExactInterval).
+template <typename PointT>
+std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionLocally(const std::vector<int>& ids,
+                                                                       const std::vector<int>& changed_slots) {
+  const auto position = [&ids](int id) { return int(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin()); };
+  std::vector<char> in_region(ids.size(), 0);
+  std::set<int> region_groups;
+  for (int id : changed_slots)
+    if (group_of_[id] >= 0) region_groups.insert(group_of_[id]);
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    if (group_of_[ids[k]] < 0) in_region[k] = 1;
+  for (int g : region_groups)
+    for (int id : groups_.at(g))
+      if (contains(id)) in_region[position(id)] = 1;
+  // ...and the groups next to them.
+  std::set<int> next_to;
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    if (in_region[k])
+      for (WeightMatrix::InnerIterator it(W_, Eigen::Index(k)); it; ++it)
+        if (!in_region[it.row()] && group_of_[ids[it.row()]] >= 0) next_to.insert(group_of_[ids[it.row()]]);
+  for (int g : next_to)
+    for (int id : groups_.at(g))
+      if (contains(id)) in_region[position(id)] = 1;
+
+  std::vector<int> region;
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    if (in_region[k]) region.push_back(int(k));
+  std::vector<std::vector<int>> groups;  // by position
+  if (!region.empty()) {
+    PartitionOptions options = getPartitionOptions();
+    options.keep_eigenvectors = false;
+    Partition local = recursivePartition(inducedSubgraph(W_, region), options);
+    for (auto& group : local.groups) {
+      for (int& k : group) k = region[k];
+      groups.push_back(std::move(group));
+    }
+    partition_.warnings = std::move(local.warnings);
+  } else {
+    partition_.warnings.clear();
+  }
+  for (const auto& [g, members] : groups_) {
+    std::vector<int> kept;
+    for (int id : members)
+      if (contains(id) && !in_region[position(id)]) kept.push_back(position(id));
+    if (!kept.empty()) groups.push_back(std::move(kept));
+  }
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
+  partition_.groups = groups;
+  partition_.splits.clear();
+  partition_.group_of.assign(ids.size(), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int k : groups[g]) partition_.group_of[k] = int(g);
+  for (auto& group : groups)
+    for (int& k : group) k = ids[k];
+  return groups;
 }
 
 template <typename PointT>
