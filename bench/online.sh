@@ -9,7 +9,7 @@
 #
 #   bench/online.sh [--output docs/performance.md] [--quick]
 #
-# --quick leaves out the 50k and 10k depth rows. With --output the table
+# --quick leaves out the full local replay of 10k and the 50k and 10k depth rows. With --output the table
 # replaces the lines between "<!-- online:begin -->" and "<!-- online:end -->".
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,21 +25,27 @@ done
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DOBSGROUP_BUILD_BENCHMARKS=ON > /dev/null
 cmake --build build -j"$(nproc)" --target online_latency > /dev/null
 exe=$(mktemp)
-cp build/bench/online_latency "$exe"  # a rebuild during the run cannot mix two versions
+cp build/bench/online_latency "$exe" && chmod +x "$exe"  # a rebuild during the run cannot mix two versions
 table=$(mktemp)
 {
 echo "Machine: $(nproc) cores; $(date -u +%Y-%m-%d); commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)."
 echo
-echo "| input | N | timed inserts | update every | median ms | p99 ms | worst ms | overlaps recomputed per update | split nodes solved per update | replay | batch compute() s | equal to batch |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| input | N | timed inserts | update every | exact every | median ms | p99 ms | worst ms | overlaps recomputed per update | split nodes solved per update | replay | batch compute() s | lowest ARI against batch | final groups equal batch |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 "$exe" 2d 1000
+"$exe" 2d 1000 --exact-every 50 --check 50
 "$exe" 2d 10000 --sample 200
+"$exe" 2d 10000 --sample 200 --exact-every 100
 "$exe" 2d 10000 --update-every 100
 "$exe" 2d 10000 --update-every 1000
 "$exe" 3d 1000
+"$exe" 3d 1000 --exact-every 50 --check 50
 if [ "$quick" = 0 ]; then
+  "$exe" 2d 10000 --exact-every 100 --check 1000
   "$exe" 2d 50000 --sample 20
+  "$exe" 2d 50000 --sample 50 --exact-every 1000
   "$exe" 3d 10000 --sample 20
+  "$exe" 3d 10000 --sample 50 --exact-every 1000
 fi
 } > "$table"
 rm -f "$exe"

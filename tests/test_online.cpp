@@ -119,6 +119,42 @@ INSTANTIATE_TEST_SUITE_P(Models, OnlineEqualsBatch,
                            return name;
                          });
 
+TEST(OnlineGrouping, CloudsIn3DEqualBatch) {
+  // 3D clouds (walls at several heights): visibility works in the band about
+  // the sensor, free space in voxels. Then a planar scan arrives among them.
+  auto obs = test::simulate3D<pcl::PointXYZ>(sim::office(), sim::officeRoute(30), {-0.5f, 0.0f, 0.4f, 1.2f});
+  for (SensedSpaceModel model : {SensedSpaceModel::Visibility, SensedSpaceModel::FreeSpace}) {
+    OnlineGrouping<pcl::PointXYZ> online;
+    online.setSensedSpaceModel(model);
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      online.insert(obs[k].cloud, obs[k].pose);
+      online.update();
+    }
+    expectEqualsBatch(online, batchLike(model), "3D " + toString(model));
+    online.remove(0);
+    online.remove(1);
+    online.update();
+    expectEqualsBatch(online, batchLike(model), "3D, first two removed " + toString(model));
+  }
+}
+
+TEST(OnlineGrouping, FromPlanarTo3DAndBack) {
+  // 2D scans, then one 3D cloud: the data is no longer planar, every region
+  // is recomputed in 3D; removing the cloud makes it planar again.
+  const auto flat = driftedOffice(20);
+  const auto tall = test::simulate3D<pcl::PointXYZ>(sim::office(), sim::officeRoute(20), {0.0f, 1.0f});
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setSensedSpaceModel(SensedSpaceModel::FreeSpace);
+  for (const auto& o : flat) online.insert(o.cloud, o.pose);
+  online.update();
+  const int id = online.insert(tall[7].cloud, tall[7].pose);
+  online.update();
+  expectEqualsBatch(online, batchLike(SensedSpaceModel::FreeSpace), "one 3D cloud");
+  online.remove(id);
+  online.update();
+  expectEqualsBatch(online, batchLike(SensedSpaceModel::FreeSpace), "planar again");
+}
+
 TEST(OnlineGrouping, PaperMethodEqualsBatch) {
   const auto obs = driftedOffice(40);
   OnlineGrouping<pcl::PointXYZ> online;

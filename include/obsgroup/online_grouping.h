@@ -161,7 +161,12 @@ class OnlineGrouping {
     bool present = false;
     Observation<PointT> observation;
   };
-  void reconfigure() { reconfigure_ = true; }
+  /// Parameters changed: the overlaps and every cached decision are stale.
+  void reconfigure() {
+    reconfigure_ = true;
+    cache_.clear();
+    exact_once_ = false;
+  }
   int firstPresent() const;
   std::vector<Eigen::Vector3f> worldPointsOf(int id, const Observation<PointT>& observation,
                                              const Eigen::Vector3d& origin) const;

@@ -74,23 +74,22 @@ template <typename PointT>
 int OnlineGrouping<PointT>::insert(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose) {
   const int id = static_cast<int>(slots_.size());
   const Observation<PointT> observation{cloud, pose};
-  const bool first = firstPresent() < 0;
+  if (!overlap_ || reconfigure_) recentreAll();  // so that the new observation is checked now
   // The common frame is re-centred on the first observation present, as
   // SensedSpaceOverlap::toWorld does (the same points, to the bit).
+  const bool first = firstPresent() < 0;
   const Eigen::Vector3d origin = first && pose.translation().allFinite() ? Eigen::Vector3d(pose.translation()) : origin_;
   std::vector<Eigen::Vector3f> points = worldPointsOf(id, observation, origin);
-  if (overlap_ && !reconfigure_) {
-    try {
-      overlap_->check(id, points, pose.translation() - origin);
-    } catch (const std::invalid_argument& e) {
-      throw InvalidObservation(id, e.what());
-    }
+  try {
+    overlap_->check(id, points, pose.translation() - origin);
+  } catch (const std::invalid_argument& e) {
+    throw InvalidObservation(id, e.what());
   }
   slots_.push_back({true, observation});
   group_of_.push_back(-1);
   ++changes_since_exact_;
   origin_ = origin;
-  if (overlap_ && !reconfigure_) overlap_->set(id, std::move(points), pose.translation() - origin);
+  overlap_->set(id, std::move(points), pose.translation() - origin);
   return id;
 }
 
@@ -114,29 +113,37 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
     }
     return;
   }
+  if (!overlap_ || reconfigure_) recentreAll();
   std::vector<Eigen::Vector3f> points = worldPointsOf(id, moved, origin_);
-  if (overlap_ && !reconfigure_) {
-    try {
-      overlap_->check(id, points, pose.translation() - origin_);
-    } catch (const std::invalid_argument& e) {
-      throw InvalidObservation(id, e.what());
-    }
-    overlap_->set(id, std::move(points), pose.translation() - origin_);
+  try {
+    overlap_->check(id, points, pose.translation() - origin_);
+  } catch (const std::invalid_argument& e) {
+    throw InvalidObservation(id, e.what());
   }
+  overlap_->set(id, std::move(points), pose.translation() - origin_);
   slots_[id].observation = moved;
 }
 
 template <typename PointT>
 void OnlineGrouping<PointT>::remove(int id) {
   if (!contains(id)) throw std::out_of_range("remove: no observation " + std::to_string(id));
+  if (!overlap_ || reconfigure_) recentreAll();
   const bool was_first = id == firstPresent();
   slots_[id].present = false;
-  slots_[id].observation = Observation<PointT>{};
-  if (was_first) {
-    recentreAll();
-  } else if (overlap_ && !reconfigure_) {
+  if (!was_first) {
     overlap_->erase(id);
+  } else {
+    // The common frame moves to the next observation: every one is re-centred.
+    try {
+      recentreAll();
+    } catch (...) {
+      slots_[id].present = true;
+      recentreAll();
+      throw;
+    }
   }
+  ++changes_since_exact_;
+  slots_[id].observation = Observation<PointT>{};
 }
 
 template <typename PointT>
@@ -177,11 +184,7 @@ GroupUpdate OnlineGrouping<PointT>::updateExact() {
 
 template <typename PointT>
 GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
-  if (reconfigure_ || !overlap_) {
-    cache_.clear();
-    exact_once_ = false;
-    recentreAll();
-  }
+  if (reconfigure_ || !overlap_) recentreAll();
   GroupUpdate out;
   const std::vector<int> changed_slots = overlap_->update(config_.getNumberOfThreads(), config_.getInterruptFlag());
   out.observations_recomputed = overlap_->recomputedLastUpdate();
