@@ -56,7 +56,7 @@ std::uint64_t nodeKey(const std::vector<int>& member_ids, int depth) {
 struct Reuse {
   const std::vector<int>& ids;
   const std::vector<char>& changed;
-  const SplitCache::Store& previous;
+  SplitCache::Store& previous;  // a copied decision is moved on to `next` when recorded
   SplitCache::Store& next;
 };
 
@@ -72,10 +72,10 @@ struct SplitCache::Store {
   std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
   std::size_t reused = 0, computed = 0;
 
-  const Entry* find(const std::vector<int>& member_ids, int depth) const {
+  Entry* find(const std::vector<int>& member_ids, int depth) {
     const auto it = entries.find(nodeKey(member_ids, depth));
     if (it == entries.end()) return nullptr;
-    for (const Entry& e : it->second)
+    for (Entry& e : it->second)
       if (e.depth == depth && e.member_ids == member_ids) return &e;
     return nullptr;
   }
@@ -181,13 +181,21 @@ class Partitioner {
     return true;
   }
 
-  /// Keeps this node's decision, by ids, for the next run.
+  /// Keeps this node's decision, by ids, for the next run: a copied one is
+  /// moved over from the previous run's (no node is visited twice in a run).
   void record(const SplitNode& current, const Decision& d) {
+    if (d.from_cache) {
+      std::vector<int> ids = idsOf(current.members);
+      SplitCache::Store::Entry* entry = reuse_->previous.find(ids, current.depth);
+      reuse_->next.add(std::move(ids), current.depth, std::move(entry->decision));
+      ++reuse_->next.reused;
+      return;
+    }
     Decision kept = d;
     kept.from_cache = false;
     for (auto& child : kept.children) child = idsOf(child);
     reuse_->next.add(idsOf(current.members), current.depth, std::move(kept));
-    ++(d.from_cache ? reuse_->next.reused : reuse_->next.computed);
+    ++reuse_->next.computed;
   }
 
   Decision decide(const SplitNode& current, std::vector<int>& local_of) const {
@@ -342,9 +350,14 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   checkWeights(W);
   auto next = std::make_shared<SplitCache::Store>();
   Reuse reuse{ids, changed, *cache.store_, *next};
-  Partition partition = Partitioner(W, options, &reuse).run();
-  cache.store_ = std::move(next);  // only when the run succeeded: an error leaves the cache as it was
-  return partition;
+  try {
+    Partition partition = Partitioner(W, options, &reuse).run();
+    cache.store_ = std::move(next);
+    return partition;
+  } catch (...) {
+    cache.clear();  // partly moved on: the next run computes every node
+    throw;
+  }
 }
 
 }  // namespace obsgroup

@@ -1,10 +1,12 @@
 // Links against an installed obsgroup: two overlapping line scans and one
 // far away give two groups, each coloured with PCL's visualization module;
-// then the same three scans as a CARMEN log, read with obsgroup::io; and,
-// when given one, a ROS bag (argv[1]) read with obsgroup::io's BagReader.
+// then the same three scans inserted one by one into an OnlineGrouping; the
+// same three scans as a CARMEN log, read with obsgroup::io; and, when given
+// one, a ROS bag (argv[1]) read with obsgroup::io's BagReader.
 #include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/io/ros_bag.h>
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/online_grouping.h>
 
 #include <pcl/point_types.h>
 #include <pcl/visualization/point_cloud_color_handlers.h>
@@ -23,6 +25,14 @@ int main(int argc, char** argv) {
   pcl::visualization::PointCloudColorHandlerCustom<pcl::PointXYZ> colour(line, 255, 0, 0);
   std::printf("package consumer: %zu groups, colour handler %s\n", partition.groups.size(),
               colour.getName().c_str());
+
+  obsgroup::OnlineGrouping<pcl::PointXYZ> online;
+  std::size_t changes = 0;
+  for (const auto& pose : {obsgroup::pose2D(0, 0, 0), obsgroup::pose2D(0.5, 0, 0), obsgroup::pose2D(0, 50, 0)}) {
+    online.insert(line, pose);
+    changes += online.update().changes.size();
+  }
+  std::printf("package consumer: online, %zu groups after %zu changes\n", online.getGroups().size(), changes);
 
   // Three FLASER scans of a wall 2 m ahead, from (0,0), (0.5,0) and (0,50).
   std::string log;
@@ -49,7 +59,7 @@ int main(int argc, char** argv) {
                 bag.topic.c_str(), bag_partition.groups.size());
     bag_ok = version.has_value() && !bag.observations.empty() && !bag_partition.groups.empty();
   }
-  return partition.groups.size() == 2 && colour.isCapable() && read.scans.size() == 3 &&
+  return partition.groups.size() == 2 && online.getPartition().groups == partition.groups && colour.isCapable() && read.scans.size() == 3 &&
                  log_partition.groups.size() == 2 && bag_ok
              ? 0
              : 1;
