@@ -113,6 +113,21 @@ TEST_F(PcdFolder, HeaderKeysAfterDataAreRefused) {
   EXPECT_NE(far.find(":211: header field 'FIELDS' after DATA"), std::string::npos) << far;
 }
 
+// Found by fuzz_pcd: PCL takes a line's first word after any white space,
+// vertical tab and form feed included, so a key after DATA behind a vertical
+// tab (or behind a comment so led) changed the point size PCL read the data
+// with, and readBodyASCII wrote past its buffer.
+TEST_F(PcdFolder, HeaderKeysAfterDataBehindAVerticalTabAreRefused) {
+  const std::string points = "1 2 3\n1 2 3\n1 2 3\n";
+  EXPECT_EQ(errorOf(header("4 4 4", "4", "1", "4") + points + "1 2 3\n"), "");
+  const std::string tab = errorOf(header("4 4 4", "4", "1", "4") + "\vSIZE 4 4 8\n" + points);
+  EXPECT_NE(tab.find(":11: header field 'SIZE' after DATA"), std::string::npos) << tab;
+  const std::string feed = errorOf(header("4 4 4", "4", "1", "4") + "\f COUNT 1 1 2\n" + points);
+  EXPECT_NE(feed.find(":11: header field 'COUNT' after DATA"), std::string::npos) << feed;
+  const std::string comment = errorOf(header("4 4 4", "4", "1", "4") + "\v# hidden\nSIZE 4 4 8\n" + points);
+  EXPECT_NE(comment.find(":12: header field 'SIZE' after DATA"), std::string::npos) << comment;
+}
+
 // Found by fuzz_pcd: with 0 points declared, PCL still allocates the
 // uncompressed size written in the data (1.3 GB from 8 forged bytes).
 TEST_F(PcdFolder, CompressedSizesAreCheckedEvenForNoPoints) {

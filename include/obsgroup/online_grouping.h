@@ -49,7 +49,7 @@ struct GroupUpdate {
   bool exact = true;
   std::size_t observations_recomputed = 0;  ///< Observations whose overlaps were recomputed.
   std::size_t split_nodes_reused = 0;       ///< Nodes of the split tree copied from the last update.
-  std::size_t split_nodes_computed = 0;     ///< Nodes solved anew.
+  std::size_t split_nodes_computed = 0;     ///< Nodes solved anew by an exact update (0 for a local one).
 };
 
 /// Online grouping: insert(), updatePose() and remove() record the change;

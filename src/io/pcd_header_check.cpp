@@ -3,6 +3,7 @@
 #include <obsgroup/io/errors.h>
 #include "text_fields.h"
 
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -28,21 +29,36 @@ void checkCounts(const std::vector<std::string_view>& f, const Header& h, const 
                          std::to_string(h.fields) + " FIELDS");
 }
 
+/// The first word of a line as PCL's readHeader takes it (`stream >> word`):
+/// any std::isspace ends it or is skipped before it, vertical tab and form
+/// feed included, where the fields of a line are split at spaces, tabs and
+/// carriage returns only.
+std::string_view pclKeyOf(std::string_view line) {
+  const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  std::size_t begin = 0;
+  while (begin < line.size() && space(line[begin])) ++begin;
+  std::size_t end = begin;
+  while (end < line.size() && !space(line[end])) ++end;
+  return line.substr(begin, end - begin);
+}
+
 /// PCL's readHeader does not stop at DATA: it reads on through empty and
 /// comment lines, and a header key there replaces the one before, so PCL
 /// would read the data with other fields than those checked here (a heap
-/// overflow in fromPCLPointCloud2; found by fuzzing). Such a file is refused.
+/// overflow in fromPCLPointCloud2, and one in readBodyASCII when a vertical
+/// tab hid the key from a split at spaces; both found by fuzzing). Such a
+/// file is refused. The keys are looked for as PCL finds them (pclKeyOf).
 void refuseHeaderAfterData(std::ifstream& in, const std::string& path, std::size_t data_line) {
   static const char* kKeys[] = {"VERSION", "FIELDS", "COLUMNS", "SIZE",   "TYPE",
                                 "COUNT",   "WIDTH",  "HEIGHT",  "VIEWPOINT", "POINTS", "DATA"};
   const std::streampos start = in.tellg();
   std::string line;
   for (std::size_t number = data_line + 1; std::getline(in, line); ++number) {  // as far as PCL reads
-    const auto f = splitFields(line);
-    if (f.empty() || f[0].front() == '#') continue;  // PCL reads on past these
-    for (const char* key : kKeys)
-      if (f[0].substr(0, std::strlen(key)) == key)
-        throw inputError(path, number, "header field '" + std::string(key) + "' after DATA: not a PCD file");
+    const std::string_view key = pclKeyOf(line);
+    if (key.empty() || key.front() == '#') continue;  // PCL reads on past comments (and past more blank lines than this)
+    for (const char* name : kKeys)
+      if (key.substr(0, std::strlen(name)) == name)
+        throw inputError(path, number, "header field '" + std::string(name) + "' after DATA: not a PCD file");
     break;
   }
   in.clear();
