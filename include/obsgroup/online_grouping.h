@@ -171,6 +171,13 @@ class OnlineGrouping {
   std::vector<Eigen::Vector3f> worldPointsOf(int id, const Observation<PointT>& observation,
                                              const Eigen::Vector3d& origin) const;
   void recentreAll();
+  struct GroupMatch {
+    std::vector<std::map<int, int>> from_old;  // new group -> old id -> members it took
+    std::map<int, std::map<int, int>> to_new;  // old id -> new group -> members it gave
+    std::vector<int> new_id;                   // the id of each new group
+  };
+  GroupMatch matchGroups(const std::vector<std::vector<int>>& groups);
+  std::vector<GroupChange> changesOf(const std::vector<std::vector<int>>& groups, const GroupMatch& match) const;
   void assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out);
   std::vector<std::vector<int>> partitionExactly(const std::vector<int>& ids, GroupUpdate& out);
   std::vector<std::vector<int>> partitionLocally(const std::vector<int>& ids, const std::vector<int>& changed_slots);

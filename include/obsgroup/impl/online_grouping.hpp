@@ -285,73 +285,86 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionLocally(const std
   return groups;
 }
 
+/// How the new groups take the old groups' members, and the id each new
+/// group gets: that of the old group it holds most of, when that old group's
+/// largest share went to it; a new id otherwise.
 template <typename PointT>
-void OnlineGrouping<PointT>::assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out) {
-  // How many members each new group takes from each old group.
-  std::vector<std::map<int, int>> from_old(groups.size());  // new group -> old id -> members
-  std::map<int, std::map<int, int>> to_new;                  // old id -> new group -> members
+typename OnlineGrouping<PointT>::GroupMatch OnlineGrouping<PointT>::matchGroups(
+    const std::vector<std::vector<int>>& groups) {
+  GroupMatch m;
+  m.from_old.resize(groups.size());
   for (std::size_t g = 0; g < groups.size(); ++g)
-    for (int id : groups[g]) {
-      const int old = group_of_[id];
-      if (old < 0) continue;
-      ++from_old[g][old];
-      ++to_new[old][int(g)];
-    }
-  // Each old group's heir: the new group holding most of it (the first on a tie).
-  std::map<int, int> heir;
-  for (const auto& [old, counts] : to_new) {
+    for (int id : groups[g])
+      if (group_of_[id] >= 0) {
+        ++m.from_old[g][group_of_[id]];
+        ++m.to_new[group_of_[id]][int(g)];
+      }
+  std::map<int, int> heir;  // old id -> the new group holding most of it (the first on a tie)
+  for (const auto& [old, counts] : m.to_new) {
     int best = -1, best_count = 0;
     for (const auto& [g, count] : counts)
       if (count > best_count) best = g, best_count = count;
     heir[old] = best;
   }
-  std::vector<int> new_id(groups.size(), -1);
+  m.new_id.assign(groups.size(), -1);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     int best = -1, best_count = 0;
-    for (const auto& [old, count] : from_old[g])
+    for (const auto& [old, count] : m.from_old[g])
       if (heir[old] == int(g) && count > best_count) best = old, best_count = count;
-    new_id[g] = best >= 0 ? best : next_group_id_++;
+    m.new_id[g] = best >= 0 ? best : next_group_id_++;
   }
+  return m;
+}
 
-  std::map<int, std::vector<int>> next;
-  for (std::size_t g = 0; g < groups.size(); ++g) next[new_id[g]] = groups[g];
+/// The changes from groups_ to `groups`: splits, then merges, then the
+/// rest by group id.
+template <typename PointT>
+std::vector<GroupChange> OnlineGrouping<PointT>::changesOf(const std::vector<std::vector<int>>& groups,
+                                                           const GroupMatch& m) const {
   std::vector<GroupChange> splits, merges, others;
-  for (const auto& [old, counts] : to_new)
+  for (const auto& [old, counts] : m.to_new)
     if (counts.size() > 1) {
       GroupChange c{GroupChange::Kind::Split, old, {}, {}};
-      for (const auto& [g, count] : counts) c.related.push_back(new_id[g]);
+      for (const auto& [g, count] : counts) c.related.push_back(m.new_id[g]);
       std::sort(c.related.begin(), c.related.end());
       splits.push_back(std::move(c));
     }
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    const int id = new_id[g];
-    if (from_old[g].size() > 1) {
+    const int id = m.new_id[g];
+    if (m.from_old[g].size() > 1) {
       GroupChange c{GroupChange::Kind::Merged, id, {}, groups[g]};
-      for (const auto& [old, count] : from_old[g]) c.related.push_back(old);
+      for (const auto& [old, count] : m.from_old[g]) c.related.push_back(old);
       merges.push_back(std::move(c));
       continue;
     }
     const auto before = groups_.find(id);
     if (before == groups_.end()) {
-      // A group of only new observations, or one split off an old group (reported as the split).
-      if (from_old[g].empty()) others.push_back({GroupChange::Kind::Created, id, {}, groups[g]});
+      // Only new observations; a group split off an old one is reported as the split.
+      if (m.from_old[g].empty()) others.push_back({GroupChange::Kind::Created, id, {}, groups[g]});
       continue;
     }
     if (before->second == groups[g]) continue;
-    const bool grew = std::includes(groups[g].begin(), groups[g].end(), before->second.begin(), before->second.end());
-    const bool shrank = std::includes(before->second.begin(), before->second.end(), groups[g].begin(), groups[g].end());
-    if (shrank && to_new[id].size() > 1) continue;  // reported as the split
+    const auto& old_members = before->second;
+    const bool grew = std::includes(groups[g].begin(), groups[g].end(), old_members.begin(), old_members.end());
+    const bool shrank = std::includes(old_members.begin(), old_members.end(), groups[g].begin(), groups[g].end());
+    if (shrank && m.to_new.at(id).size() > 1) continue;  // reported as the split
     const auto kind = grew ? GroupChange::Kind::Grown : shrank ? GroupChange::Kind::Shrunk : GroupChange::Kind::Changed;
     others.push_back({kind, id, {}, groups[g]});
   }
   for (const auto& [old, members] : groups_)
-    if (!to_new.count(old)) others.push_back({GroupChange::Kind::Removed, old, {}, {}});
+    if (!m.to_new.count(old)) others.push_back({GroupChange::Kind::Removed, old, {}, {}});
   std::sort(others.begin(), others.end(), [](const GroupChange& a, const GroupChange& b) { return a.group < b.group; });
-  out.changes = std::move(splits);
-  out.changes.insert(out.changes.end(), merges.begin(), merges.end());
-  out.changes.insert(out.changes.end(), others.begin(), others.end());
+  splits.insert(splits.end(), merges.begin(), merges.end());
+  splits.insert(splits.end(), others.begin(), others.end());
+  return splits;
+}
 
-  groups_ = std::move(next);
+template <typename PointT>
+void OnlineGrouping<PointT>::assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out) {
+  const GroupMatch match = matchGroups(groups);
+  out.changes = changesOf(groups, match);
+  groups_.clear();
+  for (std::size_t g = 0; g < groups.size(); ++g) groups_[match.new_id[g]] = groups[g];
   std::fill(group_of_.begin(), group_of_.end(), -1);
   for (const auto& [id, members] : groups_)
     for (int member : members) group_of_[member] = id;
