@@ -54,13 +54,6 @@ rm -f "$exe"
 if [ -z "$output" ]; then
   cat "$table"
 else
-  python3 - "$output" "$table" <<'PY'
-import sys
-path, table = sys.argv[1], open(sys.argv[2]).read()
-text = open(path).read()
-begin, end = "<!-- online:begin -->", "<!-- online:end -->"
-b, e = text.index(begin), text.index(end)
-open(path, "w").write(text[: b + len(begin)] + "\n" + table + text[e:])
-PY
+  python3 bench/replace_section.py "$output" online "$table"
 fi
 rm -f "$table"

@@ -51,13 +51,6 @@ done
 if [ -z "$output" ]; then
   cat "$table"
 else
-  python3 - "$output" "$table" <<'PY'
-import sys
-path, table = sys.argv[1], open(sys.argv[2]).read()
-text = open(path).read()
-begin, end = "<!-- refinement:begin -->", "<!-- refinement:end -->"
-b, e = text.index(begin), text.index(end)
-open(path, "w").write(text[: b + len(begin)] + "\n" + table + text[e:])
-PY
+  python3 bench/replace_section.py "$output" refinement "$table"
 fi
 rm -f "$table"
