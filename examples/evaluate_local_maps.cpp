@@ -35,6 +35,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <memory>
 #include <mutex>
 #include <random>
 #include <sstream>
@@ -166,6 +167,9 @@ Dataset makeDataset(const sim::Building& building, sim::Sensor sensor) {
 struct Cut {
   std::string name;
   Partition partition;
+  /// Chooses each map's reference and the pairs refinement aligns: the W of
+  /// the grouping the cut is compared with, as `obsgroup partition` uses its own.
+  std::shared_ptr<const WeightMatrix> W;
 };
 
 Partition fromGroups(std::vector<std::vector<int>> groups, int n) {
@@ -210,19 +214,22 @@ Grouped group(const std::vector<Observation<pcl::PointXYZ>>& observations, bool 
   return out;
 }
 
-/// Every cut of run 1, and the weights that choose each map's reference and
-/// the pairs refinement aligns: the paper's W at delta 0.1 m, for every cut alike.
-std::vector<Cut> makeCuts(const Dataset& d, WeightMatrix& W) {
+/// Every cut of run 1, each with the weights that choose its maps'
+/// references and the pairs refinement aligns: an obsgroup cut and the
+/// chunks as many as its maps share its grouping's W; the whole map and the
+/// chunks of 90 take the default grouping's.
+std::vector<Cut> makeCuts(const Dataset& d) {
   const int n = static_cast<int>(d.drifted.size());
-  std::vector<Cut> cuts{{"whole map", consecutiveChunks(n, 1)},
-                        {format("chunks of %d", kChunk), chunksOfSize(n, kChunk)}};
+  std::vector<Cut> cuts{{"whole map", consecutiveChunks(n, 1), nullptr},
+                        {format("chunks of %d", kChunk), chunksOfSize(n, kChunk), nullptr}};
   for (bool paper : {false, true}) {
     Grouped grouped = group(d.drifted, paper);
     const int count = static_cast<int>(grouped.partition.groups.size());
-    cuts.push_back({paper ? format("obsgroup, the paper's (δ %.1f m)", kDelta) : "obsgroup, defaults", grouped.partition});
+    const auto W = std::make_shared<const WeightMatrix>(std::move(grouped.W));
+    if (!paper) cuts[0].W = cuts[1].W = W;
+    cuts.push_back({paper ? format("obsgroup, the paper's (δ %.1f m)", kDelta) : "obsgroup, defaults", grouped.partition, W});
     // As many maps as the groups: is it the grouping, or only the number of maps?
-    cuts.push_back({format("chunks, as many (%d)", count), consecutiveChunks(n, count)});
-    if (paper) W = std::move(grouped.W);
+    cuts.push_back({format("chunks, as many (%d)", count), consecutiveChunks(n, count), W});
   }
   return cuts;
 }
@@ -391,7 +398,6 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
 struct Evaluation {
   Dataset data;
   std::vector<Cut> cuts;
-  WeightMatrix W;
   std::vector<double> coverage;  // by cut
 };
 
@@ -409,7 +415,7 @@ Row measure(const Evaluation& e, const Cut& cut, Refinement refinement) {
   builder.setRefinement(refinement);
   builder.setVoxelLeafSize(0.05);
   builder.setNumberOfThreads(1);  // the tasks are spread over the cores instead
-  const Maps maps = builder.build(e.data.drifted, cut.partition, e.W);
+  const Maps maps = builder.build(e.data.drifted, cut.partition, *cut.W);
   Row row;
   row.cut = cut.name;
   row.refinement = refinement;
@@ -532,7 +538,7 @@ std::string evaluateAll(const std::vector<std::string>& keys, const std::vector<
   runInParallel(evaluations.size(), [&](std::size_t k) {
     Evaluation& e = evaluations[k];
     e.data = makeDataset(buildings[k / sensors.size()], sensors[k % sensors.size()]);
-    e.cuts = makeCuts(e.data, e.W);
+    e.cuts = makeCuts(e.data);
     for (const Cut& cut : e.cuts) e.coverage.push_back(coverage(e.data, cut.partition));
   });
   struct Task {

@@ -716,9 +716,26 @@ std::vector<Outcome> keepWhatHelps(const std::vector<Eigen::Isometry3d>& input, 
 
 }  // namespace
 
+namespace {
+
+/// The parameters with the 3D clouds' voxel, gate and bounds in the
+/// planar fields when the points are not planar: one set is used below.
+RefinementParameters forPoints(const RefinementParameters& given, bool planar) {
+  RefinementParameters p = given;
+  if (!planar) {
+    p.alignment_voxel = given.alignment_voxel_3d;
+    p.max_correspondence_distance = given.max_correspondence_distance_3d;
+    p.max_translation_correction = given.max_translation_correction_3d;
+    p.max_rotation_correction = given.max_rotation_correction_3d;
+  }
+  return p;
+}
+
+}  // namespace
+
 RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
                                    const std::vector<std::pair<int, int>>& pairs, bool planar,
-                                   const RefinementParameters& parameters, LocalMapFrame& frame) {
+                                   const RefinementParameters& given, LocalMapFrame& frame) {
   RefinementReport report;
   const int m = static_cast<int>(frame.members.size());
   if (static_cast<int>(points.size()) != m || static_cast<int>(frame.member_poses.size()) != m)
@@ -730,10 +747,10 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   // Poses in one horizontal plane (a ground robot, whatever its sensor) are
   // refined in SE(2); the points decide only how normals are fitted.
   const Freedom freedom(posesArePlanar(frame.member_poses));
+  const RefinementParameters parameters = forPoints(given, planar);
   std::vector<std::unique_ptr<PreparedMember>> members;
   members.reserve(m);
-  const double voxel = planar ? parameters.alignment_voxel : parameters.alignment_voxel_3d;
-  for (const auto& p : points) members.push_back(prepare(p, voxel, planar));
+  for (const auto& p : points) members.push_back(prepare(p, parameters.alignment_voxel, planar));
 
   const std::vector<Eigen::Isometry3d> input = frame.member_poses;
   const PairGraph graph = alignPairs(pairs, members, input, reference, freedom, parameters, report);

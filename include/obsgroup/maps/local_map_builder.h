@@ -42,7 +42,11 @@ class LocalMapBuilder {
   void setRefinementParameters(const RefinementParameters& parameters) { parameters_ = parameters; }
   const RefinementParameters& getRefinementParameters() const { return parameters_; }
   /// Correspondence gate of the first alignment iteration, metres: bounds the pose error refinement can see.
-  void setMaxCorrespondenceDistance(double distance) { parameters_.max_correspondence_distance = distance; }
+  /// Planar scans and 3D clouds alike (RefinementParameters keeps one gate for each).
+  void setMaxCorrespondenceDistance(double distance) {
+    parameters_.max_correspondence_distance = parameters_.max_correspondence_distance_3d = distance;
+  }
+  /// The planar scans' gate (the 3D clouds' is in getRefinementParameters()).
   double getMaxCorrespondenceDistance() const { return parameters_.max_correspondence_distance; }
   /// Iterations per pairwise alignment.
   void setMaximumIterations(int iterations) { parameters_.max_iterations = iterations; }
