@@ -714,10 +714,6 @@ std::vector<Outcome> keepWhatHelps(const std::vector<Eigen::Isometry3d>& input, 
   return outcome;
 }
 
-}  // namespace
-
-namespace {
-
 /// The parameters with the 3D clouds' voxel, gate and bounds in the
 /// planar fields when the points are not planar: one set is used below.
 RefinementParameters forPoints(const RefinementParameters& given, bool planar) {
