@@ -143,6 +143,24 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, c
     const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const Errors e = measure(maps, drifted ? d.truth : input, input, planar);
+    if (std::getenv("DIAG") && drifted) {
+      for (std::size_t g = 0; g < maps.size(); ++g) {
+        const LocalMapFrame& f = maps[g].frame;
+        for (std::size_t k = 0; k < f.members.size(); ++k) {
+          const int i = f.members[k];
+          if (i == f.reference) continue;
+          // same visit: no index gap > 3 between i and the reference among the members
+          int lo = std::min(i, f.reference), hi = std::max(i, f.reference);
+          bool same = true; int prev = -100;
+          for (int j : f.members) if (j >= lo && j <= hi) { if (prev >= 0 && j - prev > 3) same = false; prev = j; }
+          const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
+          const Eigen::Isometry3d in = input[f.reference].inverse() * input[i];
+          std::fprintf(stderr, "DIAG %s g%zu m%zu ref %d i %d same %d before %.3f after %.3f rotb %.2f rota %.2f\n", toString(refinement).c_str(), g, f.members.size(), f.reference, i, int(same),
+                       size(want.inverse() * in).first, size(want.inverse() * f.member_poses[k]).first,
+                       size(want.inverse() * in).second * 180 / kPi, size(want.inverse() * f.member_poses[k]).second * 180 / kPi);
+        }
+      }
+    }
     char tail[200];
     std::snprintf(tail, sizeof tail, " | %d of %d | %d | %s | %.1f |", e.moved, e.members, e.warnings,
                   planar ? (e.off_plane == 0 ? "yes" : "**no**") : "–", seconds);
