@@ -8,13 +8,15 @@
 //                  against the truth, before and after refinement.
 //
 //   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
-//                       [--min-constraint-ratio R] [--point-neighbours N]
+//                       [--min-constraint-ratio R] [--point-neighbours N] [--by-visit]
 // prints the tables, or writes them into FILE between the lines
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
 // --min-constraint-ratio overrides RefinementParameters::min_constraint_ratio
 // (0: every direction of every pair is trusted), to measure what the guard
 // against unconstrained directions does; --point-neighbours overrides
 // RefinementParameters::point_neighbours (0: Lum pairs by W alone).
+// --by-visit also prints (to stderr) the drifted members' error split into
+// the reference's own visit of the place and other visits (a loop's return).
 
 #include "floor_plan.h"
 #include "generated_section.h"
@@ -125,7 +127,50 @@ std::string cell(const Errors& e) {
   return buffer;
 }
 
-std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, const RefinementParameters& parameters) {
+/// Whether member `i` belongs to the same visit of its place as the
+/// reference: no gap of more than 3 in the sequence between the two among
+/// the map's members.
+bool sameVisit(const LocalMapFrame& f, int i) {
+  const int lo = std::min(i, f.reference), hi = std::max(i, f.reference);
+  int previous = -1;
+  for (int j : f.members) {
+    if (j < lo || j > hi) continue;
+    if (previous >= 0 && j - previous > 3) return false;
+    previous = j;
+  }
+  return true;
+}
+
+/// The drifted members' error before (input) and after refinement, split
+/// into the reference's own visit and other visits (a loop's return).
+std::string byVisit(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d,
+                    const std::vector<Eigen::Isometry3d>& input, const std::string& label) {
+  std::vector<double> before[2], after[2];
+  for (const auto& map : maps) {
+    const LocalMapFrame& f = map.frame;
+    for (std::size_t k = 0; k < f.members.size(); ++k) {
+      const int i = f.members[k];
+      if (i == f.reference) continue;
+      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
+      const int s = sameVisit(f, i) ? 0 : 1;
+      before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
+      after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
+    }
+  }
+  std::ostringstream out;
+  char buffer[200];
+  for (int s = 0; s < 2; ++s) {
+    std::snprintf(buffer, sizeof buffer, "%s, %s: %zu members, error median / p90 %.1f / %.1f cm before, %.1f / %.1f after\n",
+                  label.c_str(), s == 0 ? "reference's visit" : "other visits", before[s].size(),
+                  100 * percentile(before[s], 0.5), 100 * percentile(before[s], 0.9), 100 * percentile(after[s], 0.5),
+                  100 * percentile(after[s], 0.9));
+    out << buffer;
+  }
+  return out.str();
+}
+
+std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, const RefinementParameters& parameters,
+                     bool by_visit) {
   const Dataset d = makeDataset(key, sensor);
   const std::vector<Eigen::Isometry3d>& input = drifted ? d.drifted : d.truth;
   std::vector<Observation<pcl::PointXYZ>> observations;
@@ -143,24 +188,7 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, c
     const auto maps = builder.build(observations, partition, grouping.getWeightMatrix());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const Errors e = measure(maps, drifted ? d.truth : input, input, planar);
-    if (std::getenv("DIAG") && drifted) {
-      for (std::size_t g = 0; g < maps.size(); ++g) {
-        const LocalMapFrame& f = maps[g].frame;
-        for (std::size_t k = 0; k < f.members.size(); ++k) {
-          const int i = f.members[k];
-          if (i == f.reference) continue;
-          // same visit: no index gap > 3 between i and the reference among the members
-          int lo = std::min(i, f.reference), hi = std::max(i, f.reference);
-          bool same = true; int prev = -100;
-          for (int j : f.members) if (j >= lo && j <= hi) { if (prev >= 0 && j - prev > 3) same = false; prev = j; }
-          const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
-          const Eigen::Isometry3d in = input[f.reference].inverse() * input[i];
-          std::fprintf(stderr, "DIAG %s g%zu m%zu ref %d i %d same %d before %.3f after %.3f rotb %.2f rota %.2f\n", toString(refinement).c_str(), g, f.members.size(), f.reference, i, int(same),
-                       size(want.inverse() * in).first, size(want.inverse() * f.member_poses[k]).first,
-                       size(want.inverse() * in).second * 180 / kPi, size(want.inverse() * f.member_poses[k]).second * 180 / kPi);
-        }
-      }
-    }
+    if (by_visit && drifted) std::cerr << byVisit(maps, d, input, d.title + " " + toString(refinement));
     char tail[200];
     std::snprintf(tail, sizeof tail, " | %d of %d | %d | %s | %.1f |", e.moved, e.members, e.warnings,
                   planar ? (e.off_plane == 0 ? "yes" : "**no**") : "–", seconds);
@@ -187,9 +215,13 @@ int main(int argc, char** argv) {
   std::vector<std::string> buildings{"office", "loop"};
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
   RefinementParameters parameters;
-  for (int a = 1; a + 1 < argc; a += 2) {
-    const std::string option = argv[a];
-    if (option == "--output") output = argv[a + 1];
+  bool by_visit = false;
+  for (int a = 1; a < argc; a += 2) {
+    const std::string option = a + 1 < argc || std::string(argv[a]) == "--by-visit" ? argv[a] : "";
+    if (option == "--by-visit") {
+      by_visit = true;
+      --a;  // takes no value
+    } else if (option == "--output") output = argv[a + 1];
     else if (option == "--buildings") buildings = splitList(argv[a + 1]);
     else if (option == "--min-constraint-ratio") parameters.min_constraint_ratio = std::atof(argv[a + 1]);
     else if (option == "--point-neighbours") parameters.point_neighbours = std::atoi(argv[a + 1]);
@@ -198,7 +230,7 @@ int main(int argc, char** argv) {
       for (const auto& s : splitList(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
     } else {
       std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...] "
-                   "[--min-constraint-ratio R] [--point-neighbours N]\n";
+                   "[--min-constraint-ratio R] [--point-neighbours N] [--by-visit]\n";
       return 2;
     }
   }
@@ -208,7 +240,7 @@ int main(int argc, char** argv) {
                      : "### Exact input poses: how far refinement moves each member in its map frame\n\n")
          << kHeader;
     for (const auto& key : buildings)
-      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters);
+      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters, by_visit);
     page << "\n";
   }
   if (output.empty()) {
