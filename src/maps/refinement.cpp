@@ -95,7 +95,7 @@ Vector6d logarithm(const Eigen::Isometry3d& pose, bool planar) {
 
 double rotationAngle(const Eigen::Isometry3d& pose) { return Eigen::AngleAxisd(pose.linear()).angle(); }
 
-constexpr double kNearAngle = 0.1 * M_PI / 180;  ///< see PairAligner::bestStart()
+constexpr double kNearAngle = 0.0017453292519943296;  ///< 0.1 degree, see PairAligner::bestStart()
 
 /// A member thinned for alignment, with a surface normal per point (zero
 /// where the neighbourhood is no line or plane) and a search tree. The tree
