@@ -5,7 +5,9 @@
 //   exact poses    how far refinement moves members that were already right
 //                  (their pose in the map frame against the input);
 //   drifted poses  the members' relative-pose error in their map frame
-//                  against the truth, before and after refinement.
+//                  against the truth, before and after refinement;
+//   joined or not  the drifted members' error split into those a chain of
+//                  alignments joins to their map's reference and the others.
 //
 //   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
 //                       [--min-constraint-ratio R] [--point-neighbours N] [--by-visit]
@@ -35,6 +37,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 using namespace obsgroup;
@@ -169,8 +172,59 @@ std::string byVisit(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Data
   return out.str();
 }
 
+/// The drifted members' error (m) before (input) and after refinement,
+/// split into the members the alignments join to their map's reference
+/// ([0]) and the others ([1], RefinementReport::unlinked).
+struct LinkedSplit {
+  std::vector<double> before[2], after[2];
+};
+
+LinkedSplit splitByLink(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d,
+                        const std::vector<Eigen::Isometry3d>& input) {
+  LinkedSplit split;
+  for (const auto& map : maps) {
+    const LocalMapFrame& f = map.frame;
+    const auto& unlinked = map.refinement.unlinked;
+    for (std::size_t k = 0; k < f.members.size(); ++k) {
+      const int i = f.members[k];
+      if (i == f.reference) continue;
+      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
+      const int s = std::count(unlinked.begin(), unlinked.end(), i) > 0 ? 1 : 0;
+      split.before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
+      split.after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
+
+    }
+  }
+  return split;
+}
+
+/// One row of the linked/unlinked table.
+std::string linkedRow(const std::string& title, Refinement refinement, const LinkedSplit& split, int exact_unlinked,
+                      int exact_members) {
+  std::ostringstream row;
+  row << "| " << title << " | " << toString(refinement);
+  char buffer[160];
+  for (int s = 0; s < 2; ++s) {
+    const auto& b = split.before[s];
+    const auto& a = split.after[s];
+    if (b.empty()) {
+      row << " | 0 | –";
+      continue;
+    }
+    std::snprintf(buffer, sizeof buffer, " | %zu | %.2f → %.2f", b.size(), 100 * percentile(b, 0.9),
+                  100 * percentile(a, 0.9));
+    row << buffer;
+  }
+  row << " | " << exact_unlinked << " of " << exact_members << " |\n";
+  return row.str();
+}
+
+/// Per dataset title: members RefinementReport::unlinked names when the
+/// input poses are exact, and all members, for Refinement::Lum.
+std::map<std::string, std::pair<int, int>> g_exact_unlinked;
+
 std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, const RefinementParameters& parameters,
-                     bool by_visit) {
+                     bool by_visit, std::ostringstream& linked_rows) {
   const Dataset d = makeDataset(key, sensor);
   const std::vector<Eigen::Isometry3d>& input = drifted ? d.drifted : d.truth;
   std::vector<Observation<pcl::PointXYZ>> observations;
@@ -189,6 +243,12 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, c
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const Errors e = measure(maps, drifted ? d.truth : input, input, planar);
     if (by_visit && drifted) std::cerr << byVisit(maps, d, input, d.title + " " + toString(refinement));
+    if (!drifted && refinement == Refinement::Lum)
+      g_exact_unlinked[d.title] = {static_cast<int>(e.report.unlinked.size()), e.members};
+    if (drifted && refinement != Refinement::None) {
+      const auto exact = g_exact_unlinked[d.title];
+      linked_rows << linkedRow(d.title, refinement, splitByLink(maps, d, input), exact.first, exact.second);
+    }
     char tail[200];
     std::snprintf(tail, sizeof tail, " | %d of %d | %d | %s | %.1f |", e.moved, e.members, e.warnings,
                   planar ? (e.off_plane == 0 ? "yes" : "**no**") : "–", seconds);
@@ -206,6 +266,11 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, c
 const char* kHeader =
     "| dataset | maps | refinement | error median / p90 (cm) | rotation median / p90 (deg) | members moved | maps "
     "with a warning | z, roll, pitch unchanged | time (s) |\n|---|---|---|---|---|---|---|---|---|\n";
+
+const char* kLinkedHeader =
+    "| dataset | refinement | joined members | their error p90, input → refined (cm) | members not joined | "
+    "their error p90, input → refined (cm) | members not joined with exact poses (lum) |\n"
+    "|---|---|---|---|---|---|---|\n";
 
 }  // namespace
 
@@ -234,15 +299,17 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  std::ostringstream page;
+  std::ostringstream page, linked_rows;
   for (bool drifted : {false, true}) {
     page << (drifted ? "### Drifted input poses: members' error in their map frame against the truth\n\n"
                      : "### Exact input poses: how far refinement moves each member in its map frame\n\n")
          << kHeader;
     for (const auto& key : buildings)
-      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters, by_visit);
+      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters, by_visit, linked_rows);
     page << "\n";
   }
+  page << "### Drifted input poses: members the alignments join to their map's reference, and the others\n\n"
+       << kLinkedHeader << linked_rows.str() << "\n";
   if (output.empty()) {
     std::cout << page.str();
     return 0;

@@ -1,7 +1,8 @@
 // Refinement of local maps (paper sec. IV-A, step 3): exact poses stay,
 // a perturbed member is corrected, a corridor's free direction is left
-// alone with a warning, planar data stays in SE(2), and errors in the
-// parallel map building name their group.
+// alone with a warning, members no alignment joins to the reference are
+// named, planar data stays in SE(2), and errors in the parallel map
+// building name their group.
 #include "floor_plan.h"
 #include "scenarios.h"
 #include "to_cloud.h"
@@ -232,4 +233,33 @@ TEST(Refinement, LumAlsoPairsPlanarScansWhosePointsShareSpace) {
   depth.W = buildWeightMatrix(10, chain);
   const auto depth_map = builder.build(depth.observations, everyone(10), depth.W);
   EXPECT_EQ(depth_map.refinement.pairs, 9);
+}
+
+TEST(Refinement, MembersNoAlignmentJoinsToTheReferenceAreNamed) {
+  // Two closed rooms 6 m apart: scans in one see nothing of the other, so
+  // the pairs across them are refused and only the input poses place the
+  // second room's scans relative to the first's.
+  sim::FloorPlan plan;
+  for (double x0 : {0.0, 10.0}) {
+    plan.addWallX(0.0, x0, x0 + 4.0);
+    plan.addWallX(4.0, x0, x0 + 4.0);
+    plan.addWallY(x0, 0.0, 4.0);
+    plan.addWallY(x0 + 4.0, 0.0, 4.0);
+  }
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  const sim::Pose2D poses[] = {{1.5, 2.0, 0.0}, {2.5, 2.0, 0.3}, {11.5, 2.0, 0.0}, {12.5, 2.0, -0.3}};
+  for (int k = 0; k < 4; ++k)
+    observations.push_back({sim::scanCloud<pcl::PointXYZ>(plan, poses[k], sim::laser360(), k), sim::toIsometry(poses[k])});
+  // Member 0 is the reference (ties go to the smaller index).
+  const WeightMatrix W = buildWeightMatrix(4, {{0, 1, 1.0}, {2, 3, 1.0}, {0, 2, 0.5}, {1, 3, 0.5}, {0, 3, 0.5}});
+  for (Refinement r : {Refinement::Icp, Refinement::Lum}) {
+    LocalMapBuilder<pcl::PointXYZ> builder;
+    builder.setRefinement(r);
+    const LocalMap<pcl::PointXYZ> map = builder.build(observations, {0, 1, 2, 3}, W);
+    ASSERT_EQ(map.frame.reference, 0) << toString(r);
+    EXPECT_EQ(map.refinement.unlinked, (std::vector<int>{2, 3})) << toString(r);
+    EXPECT_EQ(map.refinement.kept_unaligned, 0) << toString(r);
+    EXPECT_NE(map.refinement.warning().find("no alignment joins to their map's reference"), std::string::npos)
+        << map.refinement.warning();
+  }
 }

@@ -20,7 +20,9 @@
 namespace obsgroup {
 
 std::string RefinementReport::warning() const {
-  if (kept_beyond_bound == 0 && kept_unaligned == 0 && pairs_partial == 0) return "";
+  if (kept_beyond_bound == 0 && kept_unaligned == 0 && pairs_partial == 0 &&
+      static_cast<int>(unlinked.size()) <= kept_unaligned)
+    return "";
   std::string text = "refined " + std::to_string(moved) + " of " + std::to_string(members) + " members";
   if (kept_beyond_bound > 0)
     text += "; " + std::to_string(kept_beyond_bound) + " kept their input pose (the correction exceeded its bound)";
@@ -30,6 +32,12 @@ std::string RefinementReport::warning() const {
   if (pairs_partial > 0)
     text += "; " + std::to_string(pairs_partial) + " of " + std::to_string(pairs) +
             " pairs constrain only some directions (a corridor): the others keep the input poses";
+  // The unaligned members are unlinked too, and already said.
+  const int apart = static_cast<int>(unlinked.size()) - kept_unaligned;
+  if (apart > 0)
+    text += "; " + std::to_string(apart) +
+            " aligned only with members that no alignment joins to their map's reference (no surface in common "
+            "with it): their place relative to it is the input's";
   return text;
 }
 
@@ -42,6 +50,7 @@ RefinementReport& RefinementReport::operator+=(const RefinementReport& other) {
   pairs += other.pairs;
   pairs_refused += other.pairs_refused;
   pairs_partial += other.pairs_partial;
+  unlinked.insert(unlinked.end(), other.unlinked.begin(), other.unlinked.end());
   return *this;
 }
 
@@ -720,6 +729,28 @@ std::vector<Outcome> keepWhatHelps(const std::vector<Eigen::Isometry3d>& input, 
   return outcome;
 }
 
+/// Per member: whether a chain of usable alignments joins it to the reference.
+std::vector<bool> linkedToReference(int m, int reference, const std::vector<GraphEdge>& edges) {
+  std::vector<std::vector<int>> adjacent(m);
+  for (const GraphEdge& e : edges) {
+    adjacent[e.a].push_back(e.b);
+    adjacent[e.b].push_back(e.a);
+  }
+  std::vector<bool> linked(m, false);
+  std::vector<int> open{reference};
+  linked[reference] = true;
+  while (!open.empty()) {
+    const int k = open.back();
+    open.pop_back();
+    for (int j : adjacent[k])
+      if (!linked[j]) {
+        linked[j] = true;
+        open.push_back(j);
+      }
+  }
+  return linked;
+}
+
 /// The parameters with the 3D clouds' voxel, gate and bounds in the
 /// planar fields when the points are not planar: one set is used below.
 RefinementParameters forPoints(const RefinementParameters& given, bool planar) {
@@ -758,6 +789,9 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   const PairGraph graph = alignPairs(pairs, members, input, reference, freedom, parameters, report);
   std::vector<Eigen::Isometry3d> refined = solvePoseGraph(input, reference, graph.edges, freedom, parameters);
   const std::vector<Outcome> outcome = keepWhatHelps(input, refined, reference, graph, members, freedom, parameters);
+  const std::vector<bool> linked = linkedToReference(m, reference, graph.edges);
+  for (int k = 0; k < m; ++k)
+    if (!linked[k]) report.unlinked.push_back(frame.members[k]);
   for (int k = 0; k < m; ++k) {
     if (k == reference) continue;
     switch (outcome[k]) {

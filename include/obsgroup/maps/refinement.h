@@ -91,6 +91,11 @@ struct RefinementReport {
   int pairs = 0;              ///< Pairwise alignments tried.
   int pairs_refused = 0;      ///< Pairs that did not converge or overlap enough.
   int pairs_partial = 0;      ///< Pairs constraining only some directions (a corridor): the rest kept.
+  /// Observations (indices) that no chain of usable alignments joins to
+  /// their map's reference: only the input poses place them relative to it,
+  /// however well they align with the members they are joined to. A narrow
+  /// view (a depth camera) shares no surface with the views after a turn.
+  std::vector<int> unlinked;
 
   /// One line for the run's warnings, or "" when nothing deserves one
   /// (members kept because their input pose was already as good are normal).
