@@ -263,3 +263,21 @@ TEST(Refinement, MembersNoAlignmentJoinsToTheReferenceAreNamed) {
         << map.refinement.warning();
   }
 }
+
+TEST(Refinement, AWholeLaterVisitShiftedTogetherIsBroughtBack) {
+  // A loop's drift moves every scan of a later visit by the same 0.5 m and
+  // 6 degrees: the scans fit each other as they are, and only the rest of
+  // the map says they are off.
+  for (Refinement r : {Refinement::Icp, Refinement::Lum}) {
+    Scene s = officeScene(sim::Sensor::Laser360, "room 2", 10);
+    const Eigen::Isometry3d pivot = s.observations[5].pose;
+    const Eigen::Isometry3d shift = pivot * sim::toIsometry({0.5, -0.3, 6 * kDeg}) * pivot.inverse();
+    for (int k = 5; k < 10; ++k) s.observations[k].pose = shift * s.observations[k].pose;
+    const LocalMap<pcl::PointXYZ> map = refined(s, r);
+    ASSERT_LT(map.frame.reference, 5) << toString(r);
+    const auto [t, angle] = worstError(map.frame, s.truth);
+    EXPECT_LE(t, 0.02) << toString(r);
+    EXPECT_LE(angle, 0.5 * kDeg) << toString(r);
+    EXPECT_GE(map.refinement.moved, 5) << toString(r);
+  }
+}
