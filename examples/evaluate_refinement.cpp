@@ -192,7 +192,6 @@ LinkedSplit splitByLink(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const 
       const int s = std::count(unlinked.begin(), unlinked.end(), i) > 0 ? 1 : 0;
       split.before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
       split.after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
-
     }
   }
   return split;

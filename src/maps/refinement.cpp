@@ -638,11 +638,7 @@ double consistency(int k, const std::vector<int>& neighbours, const std::vector<
       // floor is always matched and says nothing about a ground robot's x, y or yaw.
       if (residual(*members[neighbours[s]], into[s] * local, into[s].linear() * members[k]->normals[i], 3 * inlier, r, n,
                    nearest))
-      {
-        const double score =
-            std::max(0.0, 1.0 - (r / inlier) * (r / inlier)) * (freedom.planar ? n.head<2>().squaredNorm() : 1.0);
-        best = std::max(best, score);
-      }
+        best = std::max(best, (1.0 - (r / inlier) * (r / inlier)) * (freedom.planar ? n.head<2>().squaredNorm() : 1.0));
     }
     sum += best;
   }
