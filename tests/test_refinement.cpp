@@ -264,6 +264,44 @@ TEST(Refinement, MembersNoAlignmentJoinsToTheReferenceAreNamed) {
   }
 }
 
+TEST(Refinement, AMapIsAnchoredWhereTheAlignmentsJoinTheMostMembers) {
+  // The same two closed rooms, two scans in the first and three in the
+  // second; W makes a first-room scan the reference, but the alignments join
+  // more members to the second room's part: the map is anchored there.
+  sim::FloorPlan plan;
+  for (double x0 : {0.0, 10.0}) {
+    plan.addWallX(0.0, x0, x0 + 4.0);
+    plan.addWallX(4.0, x0, x0 + 4.0);
+    plan.addWallY(x0, 0.0, 4.0);
+    plan.addWallY(x0 + 4.0, 0.0, 4.0);
+  }
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  const sim::Pose2D poses[] = {{1.5, 2.0, 0.0}, {2.5, 2.0, 0.3}, {11.5, 2.0, 0.0}, {12.5, 2.0, -0.3}, {12.0, 1.5, 0.5}};
+  for (int k = 0; k < 5; ++k)
+    observations.push_back({sim::scanCloud<pcl::PointXYZ>(plan, poses[k], sim::laser360(), k), sim::toIsometry(poses[k])});
+  const WeightMatrix W = buildWeightMatrix(
+      5, {{0, 1, 1.0}, {0, 2, 0.5}, {2, 3, 0.7}, {3, 4, 0.7}, {0, 4, 0.1}});
+  for (Refinement r : {Refinement::Icp, Refinement::Lum}) {
+    LocalMapBuilder<pcl::PointXYZ> builder;
+    builder.setRefinement(r);
+    const LocalMap<pcl::PointXYZ> unrefined = LocalMapBuilder<pcl::PointXYZ>().build(observations, {0, 1, 2, 3, 4}, W);
+    ASSERT_EQ(unrefined.frame.reference, 0);
+    const LocalMap<pcl::PointXYZ> map = builder.build(observations, {0, 1, 2, 3, 4}, W);
+    const int anchor = map.frame.reference;
+    EXPECT_GE(anchor, 2) << toString(r);
+    EXPECT_EQ(map.refinement.unlinked, (std::vector<int>{0, 1})) << toString(r);
+    // The frame is the anchor's, and every member still sits where it is.
+    EXPECT_TRUE(map.frame.pose.isApprox(observations[anchor].pose, 1e-3)) << toString(r);
+    for (std::size_t k = 0; k < 5; ++k) {
+      const Eigen::Isometry3d error = (map.frame.pose * map.frame.member_poses[k]).inverse() * observations[k].pose;
+      EXPECT_LE(error.translation().norm(), 0.01) << toString(r) << " member " << k;
+      EXPECT_EQ(map.frame.member_poses[k].translation().z(), 0.0) << toString(r);
+      EXPECT_EQ(map.frame.member_poses[k].linear()(0, 2), 0.0) << toString(r);
+    }
+    EXPECT_TRUE(map.frame.member_poses[anchor].isApprox(Eigen::Isometry3d::Identity())) << toString(r);
+  }
+}
+
 TEST(Refinement, AWholeLaterVisitShiftedTogetherIsBroughtBack) {
   // A loop's drift moves every scan of a later visit by the same 0.5 m and
   // 6 degrees: the scans fit each other as they are, and only the rest of

@@ -807,6 +807,37 @@ std::vector<bool> linkedToReference(int m, int reference, const std::vector<Grap
   return linked;
 }
 
+/// The member the map is anchored at: the reference, unless the usable
+/// alignments join more members to another part of the map than to the
+/// reference's; then that part's member with the most alignments (ties:
+/// the smallest position).
+int largestJoinedPart(int m, int reference, const std::vector<GraphEdge>& edges) {
+  std::vector<int> part(m, -1), degree(m, 0);
+  for (const GraphEdge& e : edges) {
+    ++degree[e.a];
+    ++degree[e.b];
+  }
+  std::vector<int> size;
+  for (int k = 0; k < m; ++k) {
+    if (part[k] >= 0) continue;
+    const std::vector<bool> joined = linkedToReference(m, k, edges);
+    size.push_back(0);
+    for (int j = 0; j < m; ++j)
+      if (joined[j]) {
+        part[j] = static_cast<int>(size.size()) - 1;
+        ++size.back();
+      }
+  }
+  int best = part[reference];
+  for (int p = 0; p < static_cast<int>(size.size()); ++p)
+    if (size[p] > size[best]) best = p;
+  if (best == part[reference]) return reference;
+  int anchor = -1;
+  for (int k = 0; k < m; ++k)
+    if (part[k] == best && (anchor < 0 || degree[k] > degree[anchor])) anchor = k;
+  return anchor;
+}
+
 /// The parameters with the 3D clouds' voxel, gate and bounds in the
 /// planar fields when the points are not planar: one set is used below.
 RefinementParameters forPoints(const RefinementParameters& given, bool planar) {
@@ -850,11 +881,21 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   // 2.75 cm at p90 in the loop building.
   const std::vector<Outcome> outcome =
       keepWhatHelps(input, refined, reference, graph, members, freedom, parameters, planar);
-  const std::vector<bool> linked = linkedToReference(m, reference, graph.edges);
+  refined[reference] = Eigen::Isometry3d::Identity();
+  const int anchor = largestJoinedPart(m, reference, graph.edges);
+  if (anchor != reference) {
+    // Written as a planar move for SE(2) maps, so that z, roll and pitch stay bit for bit.
+    const Eigen::Isometry3d to_anchor = exponential(logarithm(refined[anchor].inverse(), freedom.planar), freedom.planar);
+    for (auto& pose : refined) pose = to_anchor * pose;
+    refined[anchor] = Eigen::Isometry3d::Identity();
+    frame.pose = frame.pose * to_anchor.inverse();
+    frame.reference = frame.members[anchor];
+  }
+  const std::vector<bool> linked = linkedToReference(m, anchor, graph.edges);
   for (int k = 0; k < m; ++k)
     if (!linked[k]) report.unlinked.push_back(frame.members[k]);
   for (int k = 0; k < m; ++k) {
-    if (k == reference) continue;
+    if (k == anchor) continue;
     switch (outcome[k]) {
       case Outcome::Moved: ++report.moved; break;
       case Outcome::NotBetter: ++report.kept_not_better; break;
@@ -862,7 +903,6 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
       case Outcome::Unaligned: ++report.kept_unaligned; break;
     }
   }
-  refined[reference] = Eigen::Isometry3d::Identity();
   frame.member_poses = refined;
   return report;
 }

@@ -107,13 +107,17 @@ struct RefinementReport {
 /// The finite points of one member in its own sensor frame.
 using MemberPoints = std::vector<Eigen::Vector3f>;
 
-/// Refines `frame.member_poses` (the reference stays the identity).
+/// Refines `frame.member_poses` (the reference stays the identity). When
+/// the usable alignments join more members to another part of the map than
+/// to the reference's, the map is anchored at that part's member with the
+/// most alignments: `frame.reference` and `frame.pose` change and the poses
+/// are re-expressed in its frame (a planar move for planar poses).
 /// `points[k]` belongs to `frame.members[k]`; `pairs` are the (target,
 /// source) member positions to align, spanning tree pairs first. `planar`
 /// says every point lies in one plane (2D scans: normals are fitted in it).
 /// Members whose poses all lie in one horizontal plane (a ground robot,
 /// with a laser or a depth camera) are refined in SE(2): z, roll and pitch
-/// are left exactly as they were.
+/// are left exactly as they were (re-anchoring keeps exact zeros zero).
 RefinementReport refineMemberPoses(Refinement refinement, const std::vector<MemberPoints>& points,
                                    const std::vector<std::pair<int, int>>& pairs, bool planar,
                                    const RefinementParameters& parameters, LocalMapFrame& frame);

@@ -17,7 +17,10 @@ namespace obsgroup {
 /// reference observation (paper sec. IV-A, step 3).
 struct LocalMapFrame {
   std::vector<int> members;  ///< Observation indices, ascending.
-  int reference = -1;        ///< The member whose frame is the local map's frame.
+  /// The member whose frame is the local map's frame: strongestMember, or
+  /// after refinement the member the alignments join the most members to
+  /// (refineMemberPoses).
+  int reference = -1;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< Reference pose in the global frame.
   /// Pose of each member (in `members` order) in the reference frame; the
   /// reference's own is the identity. Refinement changes these.
