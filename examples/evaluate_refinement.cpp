@@ -285,19 +285,23 @@ int main(int argc, char** argv) {
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
   RefinementParameters parameters;
   bool by_visit = false;
-  for (int a = 1; a < argc; a += 2) {
-    const std::string option = a + 1 < argc || std::string(argv[a]) == "--by-visit" ? argv[a] : "";
-    if (option == "--by-visit") {
-      by_visit = true;
-      --a;  // takes no value
-    } else if (option == "--output") output = argv[a + 1];
-    else if (option == "--buildings") buildings = splitList(argv[a + 1]);
-    else if (option == "--min-constraint-ratio") parameters.min_constraint_ratio = std::atof(argv[a + 1]);
-    else if (option == "--min-gain") parameters.min_gain = std::atof(argv[a + 1]);
-    else if (option == "--point-neighbours") parameters.point_neighbours = std::atoi(argv[a + 1]);
-    else if (option == "--sensors") {
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    const bool value = a + 1 < argc;
+    if (arg == "--by-visit") by_visit = true;
+    else if (arg == "--output" && value) output = argv[++a];
+    else if (arg == "--buildings" && value) buildings = splitList(argv[++a]);
+    else if (arg == "--min-constraint-ratio" && value) parameters.min_constraint_ratio = std::atof(argv[++a]);
+    else if (arg == "--min-gain" && value) parameters.min_gain = std::atof(argv[++a]);
+    else if (arg == "--point-neighbours" && value) parameters.point_neighbours = std::atoi(argv[++a]);
+    else if (arg == "--sensors" && value) {
       sensors.clear();
-      for (const auto& s : splitList(argv[a + 1])) sensors.push_back(sim::sensorFromString(s));
+      try {
+        for (const auto& name : splitList(argv[++a])) sensors.push_back(sim::sensorFromString(name));
+      } catch (const std::exception& e) {
+        std::cerr << "error: " << e.what() << "\n";
+        return 2;
+      }
     } else {
       std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...] "
                    "[--min-constraint-ratio R] [--point-neighbours N] [--min-gain G] [--by-visit]\n";
