@@ -279,8 +279,7 @@ TEST(Refinement, AMapIsAnchoredWhereTheAlignmentsJoinTheMostMembers) {
   const sim::Pose2D poses[] = {{1.5, 2.0, 0.0}, {2.5, 2.0, 0.3}, {11.5, 2.0, 0.0}, {12.5, 2.0, -0.3}, {12.0, 1.5, 0.5}};
   for (int k = 0; k < 5; ++k)
     observations.push_back({sim::scanCloud<pcl::PointXYZ>(plan, poses[k], sim::laser360(), k), sim::toIsometry(poses[k])});
-  const WeightMatrix W = buildWeightMatrix(
-      5, {{0, 1, 1.0}, {0, 2, 0.5}, {2, 3, 0.7}, {3, 4, 0.7}, {0, 4, 0.1}});
+  const WeightMatrix W = buildWeightMatrix(5, {{0, 1, 1.0}, {0, 2, 0.5}, {2, 3, 0.7}, {3, 4, 0.7}, {0, 4, 0.1}});
   for (Refinement r : {Refinement::Icp, Refinement::Lum}) {
     LocalMapBuilder<pcl::PointXYZ> builder;
     builder.setRefinement(r);

@@ -888,7 +888,7 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   refined[reference] = Eigen::Isometry3d::Identity();
   const int anchor = largestJoinedPart(m, reference, graph.edges);
   if (anchor != reference) {
-    // Written as a planar move for SE(2) maps, so that z, roll and pitch stay bit for bit.
+    // A planar move for SE(2) maps: z, roll and pitch that are exactly 0 stay so.
     const Eigen::Isometry3d to_anchor = exponential(logarithm(refined[anchor].inverse(), freedom.planar), freedom.planar);
     for (auto& pose : refined) pose = to_anchor * pose;
     refined[anchor] = Eigen::Isometry3d::Identity();
