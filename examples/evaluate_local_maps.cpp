@@ -8,10 +8,11 @@
 // for internal consistency, coverage of run 2 and localization.
 //
 //   evaluate_local_maps [--output FILE] [--buildings office,loop,rooms20]
-//                       [--sensors laser360,laser180,depth]
+//                       [--sensors laser360,laser180,depth] [--failures]
 // prints the tables (by default office and loop with every sensor), or
 // writes them into FILE between the lines "<!-- generated:begin -->" and
-// "<!-- generated:end -->", keeping the rest.
+// "<!-- generated:end -->", keeping the rest. --failures also prints (to
+// stderr) each run-2 scan whose localization failed, with its map's scans.
 
 #include "floor_plan.h"
 #include "generated_section.h"
@@ -366,7 +367,21 @@ Cloud::ConstPtr forMatching(const Cloud::ConstPtr& cloud, sim::Sensor sensor) {
 struct Localization {
   Spread errors;
   double failures = 0;  // share of the scans
+  std::vector<std::string> failed;  ///< one line per failed scan, for --failures
 };
+
+/// The observations of a map as runs of consecutive indices: "146-156, 182-188".
+std::string runsOf(const std::vector<int>& members) {
+  std::string text;
+  for (std::size_t k = 0; k < members.size();) {
+    std::size_t end = k;
+    while (end + 1 < members.size() && members[end + 1] == members[end] + 1) ++end;
+    text += (text.empty() ? "" : ", ") + std::to_string(members[k]) +
+            (end > k ? "-" + std::to_string(members[end]) : "");
+    k = end + 1;
+  }
+  return text;
+}
 
 /// Aligns every run-2 scan against the map the robot picks and measures the
 /// result against the truth relative to that map's reference.
@@ -375,6 +390,7 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
   ScanMatcher matcher;
   std::vector<double> translation, rotation;
   int failures = 0;
+  std::vector<std::string> failed;
   for (std::size_t g = 0; g < maps.size(); ++g) {  // map by map: one search tree per map
     bool target_set = false;
     for (std::size_t s = 0; s < d.second.clouds.size(); ++s) {
@@ -386,10 +402,18 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
       const Eigen::Isometry3d error = truth.inverse() * estimate;
       translation.push_back(error.translation().norm());
       rotation.push_back(rotationAngle(error));
-      failures += translation.back() > kFailTranslation || rotation.back() > kFailRotation;
+      if (translation.back() > kFailTranslation || rotation.back() > kFailRotation) {
+        ++failures;
+        const Eigen::Isometry3d& start = noise[s];  // the start's error: the guess is truth * noise
+        failed.push_back(format("run-2 scan %zu: %.1f cm, %.2f deg off (start %.1f cm, %.2f deg off); map %zu, run-1 "
+                                "scans %s, reference %d",
+                                s, 100 * translation.back(), rotation.back() * 180.0 / kPi,
+                                100 * start.translation().norm(), rotationAngle(start) * 180.0 / kPi, g,
+                                runsOf(maps[g].frame.members).c_str(), maps[g].frame.reference));
+      }
     }
   }
-  return {spreadOf(translation, rotation), double(failures) / double(translation.size())};
+  return {spreadOf(translation, rotation), double(failures) / double(translation.size()), failed};
 }
 
 // --- the report ----------------------------------------------------------------
@@ -531,7 +555,8 @@ constexpr std::size_t kRowsPerCut = std::size(kRefinements);
 
 /// Every building with every sensor: datasets, cuts and coverage first, then
 /// the rows (a map build and the localization of run 2 each), the slowest first.
-std::string evaluateAll(const std::vector<std::string>& keys, const std::vector<sim::Sensor>& sensors) {
+std::string evaluateAll(const std::vector<std::string>& keys, const std::vector<sim::Sensor>& sensors,
+                        bool print_failures) {
   std::vector<sim::Building> buildings;
   for (const std::string& key : keys) buildings.push_back(sim::makeBuilding(key));
   std::vector<Evaluation> evaluations(buildings.size() * sensors.size());
@@ -570,6 +595,11 @@ std::string evaluateAll(const std::vector<std::string>& keys, const std::vector<
       const std::size_t k = b * sensors.size() + s;
       report += table(evaluations[k], rows[k]);
       tables.push_back(rows[k]);
+      if (print_failures)
+        for (const Row& row : rows[k])
+          for (const std::string& line : row.localization.failed)
+            std::cerr << buildings[b].title << ", " << sim::describe(sensors[s]) << ", " << label(row) << ": " << line
+                      << "\n";
     }
     report += buildingSummary(tables);
   }
@@ -583,14 +613,17 @@ int main(int argc, char** argv) {
   std::string output;
   std::vector<std::string> buildings{"office", "loop"};
   std::vector<std::string> sensor_names{"laser360", "laser180", "depth"};
+  bool print_failures = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
-    if (arg == "--output" && a + 1 < argc) output = argv[++a];
+    if (arg == "--failures") print_failures = true;
+    else if (arg == "--output" && a + 1 < argc) output = argv[++a];
     else if (arg == "--buildings" && a + 1 < argc) buildings = splitList(argv[++a]);
     else if (arg == "--sensors" && a + 1 < argc) sensor_names = splitList(argv[++a]);
     else {
       std::cerr << "usage: " << argv[0]
-                << " [--output FILE] [--buildings office,loop,rooms20] [--sensors laser360,laser180,depth]\n";
+                << " [--output FILE] [--buildings office,loop,rooms20] [--sensors laser360,laser180,depth]"
+                   " [--failures]\n";
       return 2;
     }
   }
@@ -599,7 +632,7 @@ int main(int argc, char** argv) {
   try {
     std::vector<sim::Sensor> sensors;
     for (const std::string& name : sensor_names) sensors.push_back(sim::sensorFromString(name));
-    report = evaluateAll(buildings, sensors);
+    report = evaluateAll(buildings, sensors, print_failures);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
