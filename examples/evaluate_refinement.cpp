@@ -11,6 +11,7 @@
 //
 //   evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,laser180,depth]
 //                       [--min-constraint-ratio R] [--point-neighbours N] [--min-gain G] [--by-visit]
+//                       [--worst]
 // prints the tables, or writes them into FILE between the lines
 // "<!-- generated:begin -->" and "<!-- generated:end -->", keeping the rest.
 // --min-constraint-ratio overrides RefinementParameters::min_constraint_ratio
@@ -20,7 +21,9 @@
 // --min-gain RefinementParameters::min_gain (-1: every solved pose within
 // the bounds is kept), to measure what the acceptance test holds back.
 // --by-visit also prints (to stderr) the drifted members' error split into
-// the reference's own visit of the place and other visits (a loop's return).
+// the reference's own visit of the place and other visits (a loop's return);
+// --worst prints the drifted members above their row's 90th percentile, each
+// with its error in the world's axes and its true position.
 
 #include "floor_plan.h"
 #include "generated_section.h"
@@ -177,6 +180,35 @@ std::string byVisit(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Data
   return out.str();
 }
 
+/// The drifted members whose refined error is above the 90th percentile of
+/// their row, each with its error in the world's axes (the truth's x, y and
+/// heading): which way the maps are still off, and where.
+std::string worstMembers(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d,
+                         const std::vector<double>& errors, const std::string& label) {
+  const double p90 = percentile(errors, 0.9);
+  std::ostringstream out;
+  char buffer[240];
+  for (const auto& map : maps) {
+    const LocalMapFrame& f = map.frame;
+    const auto& unlinked = map.refinement.unlinked;
+    for (std::size_t k = 0; k < f.members.size(); ++k) {
+      const int i = f.members[k];
+      if (i == f.reference) continue;
+      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
+      const auto [t, r] = size(want.inverse() * f.member_poses[k]);
+      if (t <= p90) continue;
+      const Eigen::Vector3d e = d.truth[f.reference].linear() * (f.member_poses[k].translation() - want.translation());
+      std::snprintf(buffer, sizeof buffer,
+                    "%s: member %d (at %.1f, %.1f) of the map of %d, %s: %.1f cm off (x %+.1f, y %+.1f cm), %.2f deg\n",
+                    label.c_str(), i, d.truth[i].translation().x(), d.truth[i].translation().y(), f.reference,
+                    std::count(unlinked.begin(), unlinked.end(), i) > 0 ? "not joined" : "joined", 100 * t, 100 * e.x(),
+                    100 * e.y(), r * 180 / kPi);
+      out << buffer;
+    }
+  }
+  return out.str();
+}
+
 /// The drifted members' error (m) before (input) and after refinement,
 /// split into the members the alignments join to their map's reference
 /// ([0]) and the others ([1], RefinementReport::unlinked).
@@ -228,7 +260,7 @@ std::string linkedRow(const std::string& title, Refinement refinement, const Lin
 std::map<std::string, std::pair<int, int>> g_exact_unlinked;
 
 std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, const RefinementParameters& parameters,
-                     bool by_visit, std::ostringstream& linked_rows) {
+                     bool by_visit, bool worst, std::ostringstream& linked_rows) {
   const Dataset d = makeDataset(key, sensor);
   const std::vector<Eigen::Isometry3d>& input = drifted ? d.drifted : d.truth;
   std::vector<Observation<pcl::PointXYZ>> observations;
@@ -247,6 +279,7 @@ std::string evaluate(const std::string& key, sim::Sensor sensor, bool drifted, c
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const Errors e = measure(maps, drifted ? d.truth : input, input, planar);
     if (by_visit && drifted) std::cerr << byVisit(maps, d, input, d.title + " " + toString(refinement));
+    if (worst && drifted) std::cerr << worstMembers(maps, d, e.translation, d.title + " " + toString(refinement));
     if (!drifted && refinement == Refinement::Lum)
       g_exact_unlinked[d.title] = {static_cast<int>(e.report.unlinked.size()), e.members};
     if (drifted && refinement != Refinement::None) {
@@ -284,11 +317,12 @@ int main(int argc, char** argv) {
   std::vector<std::string> buildings{"office", "loop"};
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
   RefinementParameters parameters;
-  bool by_visit = false;
+  bool by_visit = false, worst = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     const bool value = a + 1 < argc;
     if (arg == "--by-visit") by_visit = true;
+    else if (arg == "--worst") worst = true;
     else if (arg == "--output" && value) output = argv[++a];
     else if (arg == "--buildings" && value) buildings = splitList(argv[++a]);
     else if (arg == "--min-constraint-ratio" && value) parameters.min_constraint_ratio = std::atof(argv[++a]);
@@ -304,7 +338,7 @@ int main(int argc, char** argv) {
       }
     } else {
       std::cerr << "usage: evaluate_refinement [--output FILE] [--buildings office,loop] [--sensors laser360,...] "
-                   "[--min-constraint-ratio R] [--point-neighbours N] [--min-gain G] [--by-visit]\n";
+                   "[--min-constraint-ratio R] [--point-neighbours N] [--min-gain G] [--by-visit] [--worst]\n";
       return 2;
     }
   }
@@ -314,7 +348,7 @@ int main(int argc, char** argv) {
                      : "### Exact input poses: how far refinement moves each member in its map frame\n\n")
          << kHeader;
     for (const auto& key : buildings)
-      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters, by_visit, linked_rows);
+      for (sim::Sensor sensor : sensors) page << evaluate(key, sensor, drifted, parameters, by_visit, worst, linked_rows);
     page << "\n";
   }
   page << "### Drifted input poses: members the alignments join to their map's reference, and the others\n\n"
