@@ -152,22 +152,34 @@ bool sameVisit(const LocalMapFrame& f, int i) {
   return true;
 }
 
+/// Calls visit(map, k, want) for every non-reference member k of every
+/// map, `want` being its true pose in the map frame.
+template <typename Visit>
+void forEachMember(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d, const Visit& visit) {
+  for (const auto& map : maps) {
+    const LocalMapFrame& f = map.frame;
+    for (std::size_t k = 0; k < f.members.size(); ++k)
+      if (f.members[k] != f.reference)
+        visit(map, k, Eigen::Isometry3d(d.truth[f.reference].inverse() * d.truth[f.members[k]]));
+  }
+}
+
+bool isUnlinked(const LocalMap<pcl::PointXYZ>& map, int i) {
+  const auto& unlinked = map.refinement.unlinked;
+  return std::find(unlinked.begin(), unlinked.end(), i) != unlinked.end();
+}
+
 /// The drifted members' error before (input) and after refinement, split
 /// into the reference's own visit and other visits (a loop's return).
 std::string byVisit(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d,
                     const std::vector<Eigen::Isometry3d>& input, const std::string& label) {
   std::vector<double> before[2], after[2];
-  for (const auto& map : maps) {
+  forEachMember(maps, d, [&](const LocalMap<pcl::PointXYZ>& map, std::size_t k, const Eigen::Isometry3d& want) {
     const LocalMapFrame& f = map.frame;
-    for (std::size_t k = 0; k < f.members.size(); ++k) {
-      const int i = f.members[k];
-      if (i == f.reference) continue;
-      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
-      const int s = sameVisit(f, i) ? 0 : 1;
-      before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
-      after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
-    }
-  }
+    const int i = f.members[k], s = sameVisit(f, i) ? 0 : 1;
+    before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
+    after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
+  });
   std::ostringstream out;
   char buffer[200];
   for (int s = 0; s < 2; ++s) {
@@ -187,25 +199,19 @@ std::string worstMembers(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const
                          const std::vector<double>& errors, const std::string& label) {
   const double p90 = percentile(errors, 0.9);
   std::ostringstream out;
-  char buffer[240];
-  for (const auto& map : maps) {
+  forEachMember(maps, d, [&](const LocalMap<pcl::PointXYZ>& map, std::size_t k, const Eigen::Isometry3d& want) {
     const LocalMapFrame& f = map.frame;
-    const auto& unlinked = map.refinement.unlinked;
-    for (std::size_t k = 0; k < f.members.size(); ++k) {
-      const int i = f.members[k];
-      if (i == f.reference) continue;
-      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
-      const auto [t, r] = size(want.inverse() * f.member_poses[k]);
-      if (t <= p90) continue;
-      const Eigen::Vector3d e = d.truth[f.reference].linear() * (f.member_poses[k].translation() - want.translation());
-      std::snprintf(buffer, sizeof buffer,
-                    "%s: member %d (at %.1f, %.1f) of the map of %d, %s: %.1f cm off (x %+.1f, y %+.1f cm), %.2f deg\n",
-                    label.c_str(), i, d.truth[i].translation().x(), d.truth[i].translation().y(), f.reference,
-                    std::count(unlinked.begin(), unlinked.end(), i) > 0 ? "not joined" : "joined", 100 * t, 100 * e.x(),
-                    100 * e.y(), r * 180 / kPi);
-      out << buffer;
-    }
-  }
+    const int i = f.members[k];
+    const auto [t, r] = size(want.inverse() * f.member_poses[k]);
+    if (t <= p90) return;
+    const Eigen::Vector3d e = d.truth[f.reference].linear() * (f.member_poses[k].translation() - want.translation());
+    char buffer[240];
+    std::snprintf(buffer, sizeof buffer,
+                  "%s: member %d (at %.1f, %.1f) of the map of %d, %s: %.1f cm off (x %+.1f, y %+.1f cm), %.2f deg\n",
+                  label.c_str(), i, d.truth[i].translation().x(), d.truth[i].translation().y(), f.reference,
+                  isUnlinked(map, i) ? "not joined" : "joined", 100 * t, 100 * e.x(), 100 * e.y(), r * 180 / kPi);
+    out << buffer;
+  });
   return out.str();
 }
 
@@ -219,18 +225,12 @@ struct LinkedSplit {
 LinkedSplit splitByLink(const std::vector<LocalMap<pcl::PointXYZ>>& maps, const Dataset& d,
                         const std::vector<Eigen::Isometry3d>& input) {
   LinkedSplit split;
-  for (const auto& map : maps) {
+  forEachMember(maps, d, [&](const LocalMap<pcl::PointXYZ>& map, std::size_t k, const Eigen::Isometry3d& want) {
     const LocalMapFrame& f = map.frame;
-    const auto& unlinked = map.refinement.unlinked;
-    for (std::size_t k = 0; k < f.members.size(); ++k) {
-      const int i = f.members[k];
-      if (i == f.reference) continue;
-      const Eigen::Isometry3d want = d.truth[f.reference].inverse() * d.truth[i];
-      const int s = std::count(unlinked.begin(), unlinked.end(), i) > 0 ? 1 : 0;
-      split.before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
-      split.after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
-    }
-  }
+    const int i = f.members[k], s = isUnlinked(map, i) ? 1 : 0;
+    split.before[s].push_back(size(want.inverse() * input[f.reference].inverse() * input[i]).first);
+    split.after[s].push_back(size(want.inverse() * f.member_poses[k]).first);
+  });
   return split;
 }
 
