@@ -389,8 +389,7 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
   const std::vector<Eigen::Isometry3d> noise = guessNoise(d.second.clouds.size());
   ScanMatcher matcher;
   std::vector<double> translation, rotation;
-  int failures = 0;
-  std::vector<std::string> failed;
+  std::vector<std::string> failed;  // one line per failure: their count is the failures
   for (std::size_t g = 0; g < maps.size(); ++g) {  // map by map: one search tree per map
     bool target_set = false;
     for (std::size_t s = 0; s < d.second.clouds.size(); ++s) {
@@ -403,7 +402,6 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
       translation.push_back(error.translation().norm());
       rotation.push_back(rotationAngle(error));
       if (translation.back() > kFailTranslation || rotation.back() > kFailRotation) {
-        ++failures;
         const Eigen::Isometry3d& start = noise[s];  // the start's error: the guess is truth * noise
         failed.push_back(format("run-2 scan %zu: %.1f cm, %.2f deg off (start %.1f cm, %.2f deg off); map %zu, run-1 "
                                 "scans %s, reference %d",
@@ -413,7 +411,7 @@ Localization localize(const Dataset& d, const Partition& partition, const Maps& 
       }
     }
   }
-  return {spreadOf(translation, rotation), double(failures) / double(translation.size()), failed};
+  return {spreadOf(translation, rotation), double(failed.size()) / double(translation.size()), failed};
 }
 
 // --- the report ----------------------------------------------------------------
