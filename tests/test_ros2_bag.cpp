@@ -35,7 +35,6 @@ std::string inputErrorOf(Run run) {
 
 #include "ros2_bag_writer.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -619,26 +618,23 @@ TEST(Ros2BagSeeds, EveryFuzzSeedDecodes) {
 }
 
 // ---------------------------------------------------------------------------
-// Speed: 10,000 scans of 360 beams load well under the 3 s target.
+// A long bag is read whole and in order (its speed is measured by
+// bench/time_bag_read, never here: a test must pass on a busy machine).
 
-TEST_F(Ros2BagTest, TenThousandScansLoadQuickly) {
+TEST_F(Ros2BagTest, ThousandsOfScansAreReadWholeAndInOrder) {
   {
     Ros2BagWriter writer(bagPath());
     const bag::Scan scan = makeScan(0.0, 360);
     const auto bytes = Ros2BagWriter::serialize(scan);
-    for (int k = 0; k < 10000; ++k) writer.writeRaw("/scan", "sensor_msgs/msg/LaserScan", 1000000000 + k * 25000000LL, bytes);
-    for (int k = 0; k < 1000; ++k)
+    for (int k = 0; k < 3000; ++k) writer.writeRaw("/scan", "sensor_msgs/msg/LaserScan", 1000000000 + k * 25000000LL, bytes);
+    for (int k = 0; k < 300; ++k)
       writer.writeTf("/tf", {makeTransform(1.0 + 0.25 * k, "odom", "laser", makePose(0.01 * k, 0, 0))});
   }
-  const auto start = std::chrono::steady_clock::now();
   const bag::Messages messages = bag::readRos2Messages(bagPath(), {"/scan", std::nullopt});
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ASSERT_EQ(messages.scans.size(), 10000u);
-  EXPECT_EQ(messages.scans.back().number, 10000u);
+  ASSERT_EQ(messages.scans.size(), 3000u);
+  for (std::size_t k = 0; k < messages.scans.size(); ++k) ASSERT_EQ(messages.scans[k].number, k + 1);
   EXPECT_EQ(messages.scans.back().message.ranges.size(), 360u);
-  EXPECT_EQ(messages.tf.size(), 1000u);
-  std::printf("10,000 LaserScans (360 beams) and 1,000 /tf messages read in %.3f s\n", seconds);
-  EXPECT_LT(seconds, 3.0);
+  EXPECT_EQ(messages.tf.size(), 300u);
 }
 
 }  // namespace

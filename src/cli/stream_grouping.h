@@ -5,6 +5,7 @@
 
 #include "grouping_outcome.h"
 #include "partition_command.h"
+#include "replay_clock.h"
 
 #include <obsgroup/common/invalid_observation.h>
 #include <obsgroup/common/parallel_for.h>
@@ -15,7 +16,6 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace obsgroup::cli {
@@ -31,39 +31,6 @@ inline std::string describeChange(const GroupChange& change) {
   if (n > 0) text += " (" + std::to_string(n) + " observation" + (n == 1 ? "" : "s") + ")";
   return text;
 }
-
-/// Paces a replay at the input's stamps: observation k is due at
-/// t0 + (stamp_k - stamp_0) wall time, t0 being when observation 0 came.
-/// The schedule is absolute, so a slow update is caught up on, and a stamp
-/// that goes backwards is already due: it is not slept on.
-class ReplayClock {
- public:
-  using Clock = std::chrono::steady_clock;
-  /// `stamps` null: no pacing.
-  ReplayClock(const std::vector<double>* stamps, const InterruptFlag* interrupt)
-      : stamps_(stamps), interrupt_(interrupt) {}
-
-  void waitFor(std::size_t k) {
-    if (!stamps_) return;
-    if (k == 0) start_ = Clock::now();
-    const auto due = start_ + std::chrono::duration_cast<Clock::duration>(
-                                  std::chrono::duration<double>((*stamps_)[k] - (*stamps_)[0]));
-    const auto before = Clock::now();
-    // Short naps, so that Ctrl-C stops a replay waiting for a late stamp.
-    for (auto now = before; now < due; now = Clock::now()) {
-      throwIfInterrupted(interrupt_);
-      std::this_thread::sleep_for(std::min<Clock::duration>(due - now, std::chrono::milliseconds(50)));
-    }
-    waited_s_ += std::chrono::duration<double>(Clock::now() - before).count();
-  }
-  double waitedSeconds() const { return waited_s_; }
-
- private:
-  const std::vector<double>* stamps_;
-  const InterruptFlag* interrupt_;
-  Clock::time_point start_;
-  double waited_s_ = 0.0;
-};
 
 /// Each observation's points after filtering, as the batch overlap counts
 /// them (SensedSpaceOverlap::toWorld), without keeping them.
