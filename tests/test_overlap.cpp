@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <limits>
+#include <stdexcept>
 
 using namespace obsgroup;
 
@@ -30,6 +32,7 @@ template <typename PointT>
 OverlapResult overlapWith(const std::vector<Observation<PointT>>& observations, NeighbourSearch method,
                           double delta = 0.1, double voxel = 0.0, int threads = 0) {
   SensedSpaceOverlap<PointT> sso;
+  sso.setSensedSpaceModel(SensedSpaceModel::Points);  // eq. (16)-(17): what this file tests
   sso.setMatchDistance(delta);
   sso.setVoxelLeafSize(voxel);
   sso.setNeighbourSearch(method);
@@ -158,6 +161,7 @@ TEST(SensedSpaceOverlap, UserSearchMethodGivesTheSameMatrix) {
   const auto obs = test::realLog(20);
   ASSERT_EQ(obs.size(), 20u);
   SensedSpaceOverlap<pcl::PointXYZ> sso;
+  sso.setSensedSpaceModel(SensedSpaceModel::Points);
   sso.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
   EXPECT_EQ(sso.getNeighbourSearch(), NeighbourSearch::PclSearch);
   expectSameMatrix<pcl::PointXYZ>(sso.compute(obs), overlapWith(obs, NeighbourSearch::SharedGrid));
@@ -263,6 +267,7 @@ TEST(SensedSpaceOverlap, ProgressCountsObservationsAndEndsAtTheTotal) {
   const auto obs = test::realLog(20);
   for (auto method : kBackEnds) {
     SensedSpaceOverlap<pcl::PointXYZ> sso;
+    sso.setSensedSpaceModel(SensedSpaceModel::Points);
     sso.setNeighbourSearch(method);
     std::vector<std::pair<std::size_t, std::size_t>> calls;
     sso.setProgressCallback([&calls](std::size_t done, std::size_t total) { calls.emplace_back(done, total); });
@@ -308,5 +313,59 @@ TEST(SensedSpaceOverlap, EmptyObservationMatchesNothing) {
     const OverlapResult r = overlapWith(obs, method);
     EXPECT_TRUE(r.pairs.empty());
     EXPECT_EQ(r.points_per_observation[1], 0u);
+  }
+}
+
+namespace {
+
+/// A kd-tree that fails on its `fail_at`-th radius search, as a user's own
+/// search object might.
+class FailingSearch : public pcl::search::KdTree<pcl::PointXYZ> {
+ public:
+  explicit FailingSearch(int fail_at) : fail_at_(fail_at) {}
+  int radiusSearch(const pcl::PointXYZ& point, double radius, pcl::Indices& k_indices,
+                   std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override {
+    if (++calls_ == fail_at_) throw std::runtime_error("the user's search failed");
+    return pcl::search::KdTree<pcl::PointXYZ>::radiusSearch(point, radius, k_indices, k_sqr_distances, max_nn);
+  }
+
+ private:
+  int fail_at_;
+  mutable int calls_ = 0;
+};
+
+}  // namespace
+
+// The user's code runs inside parallel loops: its exception reaches the
+// caller unchanged, on any thread count, never std::terminate.
+TEST(SensedSpaceOverlap, ExceptionsOfTheUsersCodeReachTheCaller) {
+  const auto obs = test::realLog(20);
+  for (int threads : {1, 2, 4}) {
+    for (auto method : kBackEnds) {
+      SensedSpaceOverlap<pcl::PointXYZ> sso;
+      sso.setSensedSpaceModel(SensedSpaceModel::Points);  // the parallel loops that report progress
+      sso.setNeighbourSearch(method);
+      sso.setNumberOfThreads(threads);
+      std::atomic<int> calls{0};
+      sso.setProgressCallback([&calls](std::size_t, std::size_t) {
+        if (++calls == 2) throw std::runtime_error("progress callback failed");
+      });
+      try {
+        sso.compute(obs);
+        ADD_FAILURE() << "no exception";
+      } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "progress callback failed");
+      }
+    }
+    SensedSpaceOverlap<pcl::PointXYZ> sso;
+    sso.setSensedSpaceModel(SensedSpaceModel::Points);
+    sso.setNumberOfThreads(threads);
+    sso.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new FailingSearch(100)));
+    try {
+      sso.compute(obs);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "the user's search failed");
+    }
   }
 }

@@ -573,32 +573,29 @@ CellMatches matchCells(const Grid& grid, double delta, int threads, const Progre
   const float inside = float(delta * delta * (1.0 - 1e-4)), outside = float(delta * delta * (1.0 + 1e-4));
   const std::vector<Run>& runs = grid.runs();
   std::atomic<std::size_t> done{0};
-#pragma omp parallel num_threads(threads)
-  {
-    NeighbourhoodScratch scratch(grid.observations());
-    bool stopped = false;  // no throwing inside the parallel region
-#pragma omp for schedule(dynamic, 256)
-    for (std::size_t c = 0; c < cells; ++c) {
-      if (c % 256 == 0) {
-        stopped = stopped || interruptRequested(interrupt);
-        const std::size_t now = done += 256;
-        if (progress && omp_get_thread_num() == 0) progress(std::min(now, cells), progress_total);
-      }
-      if (stopped) continue;
-      const std::uint32_t groups = groupNeighbourhood(grid, c, out.near.data() + out.near_offsets[c], scratch);
-      const std::size_t words = out.words(c);
-      std::uint64_t* mask = out.masks.data() + out.mask_offsets[c];
-      const Span own = grid.runsOfCell(c);
-      for (std::uint32_t r = own.begin; r < own.end; ++r) {
-        const std::uint32_t self = scratch.group[runs[r].observation];
-        for (std::uint32_t k = runs[r].begin; k < runs[r].end; ++k, mask += words)
-          if (grid.planar())
-            matchPoint<true>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
-          else
-            matchPoint<false>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
-      }
-    }
-  }
+  // The progress callback is the user's code: parallelFor hands its
+  // exception, as the interruption's, to the caller.
+  parallelForWithScratch(
+      cells, threads, 256, [&grid] { return NeighbourhoodScratch(grid.observations()); },
+      [&](std::size_t c, NeighbourhoodScratch& scratch) {
+        if (c % 256 == 0) {
+          throwIfInterrupted(interrupt);
+          const std::size_t now = done += 256;
+          if (progress && omp_get_thread_num() == 0) progress(std::min(now, cells), progress_total);
+        }
+        const std::uint32_t groups = groupNeighbourhood(grid, c, out.near.data() + out.near_offsets[c], scratch);
+        const std::size_t words = out.words(c);
+        std::uint64_t* mask = out.masks.data() + out.mask_offsets[c];
+        const Span own = grid.runsOfCell(c);
+        for (std::uint32_t r = own.begin; r < own.end; ++r) {
+          const std::uint32_t self = scratch.group[runs[r].observation];
+          for (std::uint32_t k = runs[r].begin; k < runs[r].end; ++k, mask += words)
+            if (grid.planar())
+              matchPoint<true>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
+            else
+              matchPoint<false>(grid.points()[k], self, groups, within, inside, outside, scratch, mask);
+        }
+      });
   return out;
 }
 
@@ -672,21 +669,20 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   const ProgressCallback report = progress ? in_observations : ProgressCallback{};
   const CellMatches matches = matchCells(grid, delta, nthreads, report, progress_total, interrupt);
   throwIfInterrupted(interrupt);
-  std::uint64_t pairs = 0;
+  std::vector<std::uint64_t> row_pairs(n, 0);
   std::atomic<std::size_t> done{0};
-#pragma omp parallel num_threads(nthreads) reduction(+ : pairs)
-  {
-    RowScratch scratch(n);
-#pragma omp for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) {
-      if (interruptRequested(interrupt)) continue;
-      countRow(grid, matches, i, scratch, out.rows[i]);
-      const std::size_t now = ++done;
-      if (report && omp_get_thread_num() == 0) report(grid.cells() + now, progress_total);
-    }
-    pairs += scratch.pairs;
-  }
-  throwIfInterrupted(interrupt);
+  parallelForWithScratch(
+      std::size_t(n), nthreads, 16, [n] { return RowScratch(n); },
+      [&](std::size_t i, RowScratch& scratch) {
+        throwIfInterrupted(interrupt);
+        const std::uint64_t before = scratch.pairs;
+        countRow(grid, matches, int(i), scratch, out.rows[i]);
+        row_pairs[i] = scratch.pairs - before;
+        const std::size_t now = ++done;
+        if (report && omp_get_thread_num() == 0) report(grid.cells() + now, progress_total);
+      });
+  std::uint64_t pairs = 0;
+  for (const std::uint64_t p : row_pairs) pairs += p;
   if (progress) progress(n, n);
   out.pairs_evaluated = pairs;
   out.point_tests = matches.point_tests;

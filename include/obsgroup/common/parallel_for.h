@@ -6,8 +6,11 @@
 /// thread count) and rethrown unchanged after the loop. Every parallel loop
 /// of obsgroup that can throw goes through these two functions.
 
+#include <atomic>
 #include <cstddef>
+#include <algorithm>
 #include <exception>
+#include <optional>
 #include <utility>
 
 #ifdef _OPENMP
@@ -32,25 +35,38 @@ inline int threadCount(int threads) {
 /// the exception of the smallest failing index.
 template <typename MakeScratch, typename Body>
 void parallelForWithScratch(std::size_t n, int threads, int chunk, MakeScratch&& make_scratch, Body&& body) {
-  std::exception_ptr first;
-  std::size_t first_index = n;
+  std::exception_ptr first, scratch_failed;
+  // Indices after a failed one are skipped: they cannot change which
+  // exception is rethrown, and a failing callback should not be called on.
+  std::atomic<std::size_t> first_index{n};
   const long long count = static_cast<long long>(n);
 #pragma omp parallel num_threads(threadCount(threads))
   {
-    auto scratch = make_scratch();
+    // Every thread must reach the loop (a worksharing construct), so a
+    // scratch that cannot be made is remembered, not thrown here.
+    std::optional<decltype(make_scratch())> scratch;
+    try {
+      scratch.emplace(make_scratch());
+    } catch (...) {
+#pragma omp critical(obsgroup_parallel_for)
+      if (!scratch_failed) scratch_failed = std::current_exception();
+      first_index = 0;
+    }
 #pragma omp for schedule(dynamic, chunk)
     for (long long i = 0; i < count; ++i) {
+      if (!scratch || static_cast<std::size_t>(i) > first_index.load(std::memory_order_relaxed)) continue;
       try {
-        body(static_cast<std::size_t>(i), scratch);
+        body(static_cast<std::size_t>(i), *scratch);
       } catch (...) {
 #pragma omp critical(obsgroup_parallel_for)
-        if (static_cast<std::size_t>(i) < first_index) {
-          first_index = static_cast<std::size_t>(i);
+        if (static_cast<std::size_t>(i) < first_index || !first) {
+          first_index = std::min<std::size_t>(first_index, static_cast<std::size_t>(i));
           first = std::current_exception();
         }
       }
     }
   }
+  if (scratch_failed) std::rethrow_exception(scratch_failed);
   if (first) std::rethrow_exception(first);
 }
 

@@ -138,23 +138,26 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
   const int n = world.size();
   const auto candidates = overlappingBoxes(world, delta_);
   std::vector<std::vector<MatchCount>> columns(n);
-  std::uint64_t pairs = 0, tests = 0;
+  std::vector<std::uint64_t> column_tests(n, 0);
   std::atomic<std::size_t> done{0};
   // A user's search object is shared, so it runs on one thread; otherwise
-  // each thread owns a kd-tree.
-  const int threads = search_ ? 1 : (threadCount(threads_));
-#pragma omp parallel num_threads(threads) reduction(+ : pairs, tests)
-  {
-    SearchMethodPtr search = search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false));
-#pragma omp for schedule(dynamic, 4)
-    for (int j = 0; j < n; ++j) {
-      if (interruptRequested(interrupt_)) continue;  // no throwing inside the parallel region
-      if (!candidates[j].empty())
-        columns[j] = detail::countColumnPclSearch(*search, world, j, candidates[j], delta_, tests);
-      pairs += candidates[j].size();
-      const std::size_t now = ++done;
-      if (progress_ && omp_get_thread_num() == 0) progress_(now, n);
-    }
+  // each thread owns a kd-tree. The search object and the progress callback
+  // are the user's code: parallelFor hands their exceptions to the caller.
+  const int threads = search_ ? 1 : threadCount(threads_);
+  parallelForWithScratch(
+      std::size_t(n), threads, 4,
+      [this] { return search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false)); },
+      [&](std::size_t j, SearchMethodPtr& search) {
+        throwIfInterrupted(interrupt_);
+        if (!candidates[j].empty())
+          columns[j] = detail::countColumnPclSearch(*search, world, int(j), candidates[j], delta_, column_tests[j]);
+        const std::size_t now = ++done;
+        if (progress_ && omp_get_thread_num() == 0) progress_(now, n);
+      });
+  std::uint64_t pairs = 0, tests = 0;
+  for (int j = 0; j < n; ++j) {
+    pairs += candidates[j].size();
+    tests += column_tests[j];
   }
   throwIfInterrupted(interrupt_);
   if (progress_) progress_(n, n);
