@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 
 using namespace obsgroup;
 
@@ -246,4 +248,94 @@ TEST(LocalMapBuilder, TooManyVoxelsKeepsTheMapUnfilteredAndSaysSo) {
   EXPECT_EQ(map.cloud->size(), 20u);
   builder.setVoxelLeafSize(0.5);
   EXPECT_TRUE(builder.build(obs, {0, 1}, W).filtered);
+}
+
+namespace {
+
+/// The message of the std::invalid_argument `f` throws, or "" (and a failure) when it throws none.
+template <typename F>
+std::string invalidArgumentOf(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::invalid_argument";
+  return "";
+}
+
+}  // namespace
+
+// A caller's bad group, W or cloud is an std::invalid_argument naming what is
+// wrong, never a read out of bounds.
+TEST(LocalMapBuilder, BadArgumentsAreRefusedByName) {
+  auto obs = westRoom();
+  const WeightMatrix W = chain(5);
+  LocalMapBuilder<pcl::PointXYZ> builder;
+  builder.setRefinement(Refinement::Lum);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {0, 1, 7}, W); }).find("index 7 at position 2"),
+            std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {0, -1}, W); }).find("index -1"), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {2, 1}, W); }).find("ascend"), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {1, 1}, W); }).find("ascend"), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, pcl::Indices{}, W); }).find("empty group"), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {0, 1}, chain(3)); }).find("W is 3 x 3 for 5 observations"),
+            std::string::npos);
+  Partition partition;
+  partition.groups = {{0, 1}, {2, 3, 9}};
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, partition, W); }).find("local map 1: "), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, partition, chain(4)); }).find("W is 4 x 4"), std::string::npos);
+  auto nan_pose = obs;
+  nan_pose[1].pose.translation().y() = std::nan("");
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(nan_pose, {0, 1}, W); }).find("observation 1 is not finite"),
+            std::string::npos);
+  obs[2].cloud.reset();
+  EXPECT_NE(invalidArgumentOf([&] { builder.build(obs, {0, 2}, W); }).find("observation 2 has no cloud"),
+            std::string::npos);
+  EXPECT_NO_THROW(builder.build(obs, {0, 1}, W));  // the null cloud is not a member
+}
+
+TEST(TopologicalMap, BadFramesAreRefusedByName) {
+  const WeightMatrix W = chain(4);
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 4; ++i) poses.push_back(pose2D(i, 0, 0));
+  EXPECT_NE(invalidArgumentOf([&] { initialFrame({0, 4}, W, poses); }).find("index 4"), std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { initialFrame({0, 1}, chain(3), poses); }).find("W is 3 x 3 for 4"),
+            std::string::npos);
+  EXPECT_NE(invalidArgumentOf([&] { strongestMember({3, 0}, W); }).find("ascend"), std::string::npos);
+  Partition partition;
+  partition.groups = {{0, 1}, {2, 3}};
+  std::vector<LocalMapFrame> frames = initialFrames(partition, W, poses);
+  EXPECT_NO_THROW(buildTopologicalMap(frames, W, poses));
+  EXPECT_NE(invalidArgumentOf([&] { buildTopologicalMap(frames, chain(3), poses); }).find("W is 3 x 3"),
+            std::string::npos);
+  auto twice = frames;
+  twice[1] = initialFrame({1, 2, 3}, W, poses);
+  EXPECT_NE(invalidArgumentOf([&] { buildTopologicalMap(twice, W, poses); }).find("observation 1 is also in local map 0"),
+            std::string::npos);
+  auto missing = frames;
+  missing[1] = initialFrame({2}, W, poses);
+  EXPECT_NE(invalidArgumentOf([&] { buildTopologicalMap(missing, W, poses); }).find("observation 3 is in no local map"),
+            std::string::npos);
+  auto short_poses = frames;
+  short_poses[0].member_poses.pop_back();
+  EXPECT_NE(invalidArgumentOf([&] { buildTopologicalMap(short_poses, W, poses); }).find("1 member poses for 2"),
+            std::string::npos);
+  auto far = poses;
+  far[3].translation().x() = std::numeric_limits<double>::infinity();
+  EXPECT_NE(invalidArgumentOf([&] { buildTopologicalMap(frames, W, far); }).find("observation 3 is not finite"),
+            std::string::npos);
+  partition.groups = {{0, 1}, {2, 5}};
+  EXPECT_NE(invalidArgumentOf([&] { initialFrames(partition, W, poses); }).find("group 1: initialFrame: index 5"),
+            std::string::npos);
+  // Refinement's own entry point: pairs and the reference are checked too.
+  LocalMapFrame frame = initialFrame({0, 1}, W, poses);
+  const std::vector<MemberPoints> points(2, MemberPoints{Eigen::Vector3f(1, 0, 0)});
+  EXPECT_NE(invalidArgumentOf([&] { refineMemberPoses(Refinement::Lum, points, {{0, 2}}, true, {}, frame); })
+                .find("pair (0, 2)"),
+            std::string::npos);
+  frame.reference = 3;
+  EXPECT_NE(invalidArgumentOf([&] { refineMemberPoses(Refinement::Lum, points, {{0, 1}}, true, {}, frame); })
+                .find("reference 3 is not a member"),
+            std::string::npos);
 }

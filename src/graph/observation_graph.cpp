@@ -37,6 +37,26 @@ WeightMatrix buildWeightMatrix(int n, const std::vector<WeightedPair>& pairs, do
   return W;
 }
 
+void checkMembers(const std::string& who, const std::vector<int>& members, Eigen::Index n) {
+  if (members.empty()) throw std::invalid_argument(who + ": empty group");
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    if (members[k] < 0 || members[k] >= n)
+      throw std::invalid_argument(who + ": index " + std::to_string(members[k]) + " at position " +
+                                  std::to_string(k) + " of the group is out of range (" + std::to_string(n) +
+                                  " observations)");
+    if (k > 0 && members[k] <= members[k - 1])
+      throw std::invalid_argument(who + ": the group's indices must ascend without repeats (" +
+                                  std::to_string(members[k - 1]) + " then " + std::to_string(members[k]) +
+                                  " at position " + std::to_string(k) + ")");
+  }
+}
+
+void checkWeightMatrixSize(const std::string& who, const WeightMatrix& W, Eigen::Index n) {
+  if (W.rows() != n || W.cols() != n)
+    throw std::invalid_argument(who + ": W is " + std::to_string(W.rows()) + " x " + std::to_string(W.cols()) +
+                                " for " + std::to_string(n) + " observations");
+}
+
 Eigen::VectorXd degrees(const WeightMatrix& W) {
   Eigen::VectorXd d = Eigen::VectorXd::Zero(W.outerSize());
   for (int k = 0; k < W.outerSize(); ++k)
@@ -46,9 +66,10 @@ Eigen::VectorXd degrees(const WeightMatrix& W) {
 
 WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members, std::vector<int>& local_of) {
   const int m = static_cast<int>(members.size());
-  for (int k = 1; k < m; ++k)
-    if (members[k] <= members[k - 1])
-      throw std::invalid_argument("inducedSubgraph: members must be sorted ascending and unique");
+  if (W.rows() != W.cols()) throw std::invalid_argument("inducedSubgraph: W must be square");
+  if (Eigen::Index(local_of.size()) != W.rows())
+    throw std::invalid_argument("inducedSubgraph: the scratch needs one entry per node of W");
+  if (m > 0) checkMembers("inducedSubgraph", members, W.rows());
   for (int k = 0; k < m; ++k) local_of[members[k]] = k;
   // Members ascend, so local indices ascend with W's row indices: each column
   // is filled in order, straight into compressed storage.

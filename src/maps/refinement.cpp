@@ -16,6 +16,7 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 namespace obsgroup {
 
@@ -864,6 +865,18 @@ RefinementReport refineMemberPoses(Refinement refinement, const std::vector<Memb
   const int m = static_cast<int>(frame.members.size());
   if (static_cast<int>(points.size()) != m || static_cast<int>(frame.member_poses.size()) != m)
     throw std::invalid_argument("refineMemberPoses: one point list and one pose per member expected");
+  if (m > 0) checkMembers("refineMemberPoses", frame.members, std::numeric_limits<int>::max());
+  if (m > 0 && !std::binary_search(frame.members.begin(), frame.members.end(), frame.reference))
+    throw std::invalid_argument("refineMemberPoses: the reference " + std::to_string(frame.reference) +
+                                " is not a member");
+  for (int k = 0; k < m; ++k)
+    if (!frame.member_poses[k].matrix().allFinite())
+      throw std::invalid_argument("refineMemberPoses: the pose of member " + std::to_string(frame.members[k]) +
+                                  " is not finite");
+  for (const auto& [target, source] : pairs)
+    if (target < 0 || target >= m || source < 0 || source >= m || target == source)
+      throw std::invalid_argument("refineMemberPoses: pair (" + std::to_string(target) + ", " +
+                                  std::to_string(source) + ") is not two member positions of " + std::to_string(m));
   const int reference = static_cast<int>(std::lower_bound(frame.members.begin(), frame.members.end(), frame.reference) -
                                          frame.members.begin());
   report.members = m - 1;

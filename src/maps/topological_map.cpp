@@ -1,10 +1,10 @@
 #include "obsgroup/maps/topological_map.h"
 
+#include "obsgroup/common/parallel_for.h"
 #include "obsgroup/maps/pose_average.h"
 
-#include <omp.h>
-
 #include <algorithm>
+#include <string>
 #include <tuple>
 #include <stdexcept>
 #include <utility>
@@ -17,7 +17,19 @@ const Eigen::Isometry3d& LocalMapFrame::memberPose(int i) const {
   return member_poses[it - members.begin()];
 }
 
+namespace {
+
+void checkPosesFinite(const std::string& who, const std::vector<Eigen::Isometry3d>& poses) {
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    if (!poses[i].matrix().allFinite())
+      throw std::invalid_argument(who + ": the pose of observation " + std::to_string(i) + " is not finite");
+}
+
+}  // namespace
+
 int strongestMember(const std::vector<int>& group, const WeightMatrix& W) {
+  if (W.rows() != W.cols()) throw std::invalid_argument("strongestMember: W must be square");
+  checkMembers("strongestMember", group, W.rows());
   int best = group.front();
   double best_strength = -1.0;
   for (int i : group) {
@@ -35,6 +47,12 @@ int strongestMember(const std::vector<int>& group, const WeightMatrix& W) {
 
 LocalMapFrame initialFrame(const std::vector<int>& group, const WeightMatrix& W,
                            const std::vector<Eigen::Isometry3d>& poses) {
+  const Eigen::Index n = Eigen::Index(poses.size());
+  checkWeightMatrixSize("initialFrame", W, n);
+  checkMembers("initialFrame", group, n);
+  for (int i : group)
+    if (!poses[i].matrix().allFinite())
+      throw std::invalid_argument("initialFrame: the pose of observation " + std::to_string(i) + " is not finite");
   LocalMapFrame frame;
   frame.members = group;
   frame.reference = strongestMember(group, W);
@@ -47,7 +65,11 @@ LocalMapFrame initialFrame(const std::vector<int>& group, const WeightMatrix& W,
 std::vector<LocalMapFrame> initialFrames(const Partition& partition, const WeightMatrix& W,
                                          const std::vector<Eigen::Isometry3d>& poses) {
   std::vector<LocalMapFrame> frames;
-  for (const auto& group : partition.groups) frames.push_back(initialFrame(group, W, poses));
+  for (std::size_t g = 0; g < partition.groups.size(); ++g) try {
+      frames.push_back(initialFrame(partition.groups[g], W, poses));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("group " + std::to_string(g) + ": " + e.what());
+    }
   return frames;
 }
 
@@ -113,12 +135,30 @@ TopologicalArc makeArc(int from, const std::vector<CrossPair>& pairs, std::size_
 TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
                                    const std::vector<Eigen::Isometry3d>& poses, int threads) {
   const int n = static_cast<int>(poses.size());
-  if (W.rows() != n) throw std::invalid_argument("buildTopologicalMap: W and poses disagree in size");
+  checkWeightMatrixSize("buildTopologicalMap", W, n);
+  checkPosesFinite("buildTopologicalMap", poses);
   std::vector<int> node_of(n, -1);
-  for (std::size_t k = 0; k < nodes.size(); ++k)
-    for (int i : nodes[k].members) node_of.at(i) = static_cast<int>(k);
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const std::string who = "buildTopologicalMap: local map " + std::to_string(k);
+    const LocalMapFrame& node = nodes[k];
+    checkMembers(who, node.members, n);
+    if (node.member_poses.size() != node.members.size())
+      throw std::invalid_argument(who + ": " + std::to_string(node.member_poses.size()) + " member poses for " +
+                                  std::to_string(node.members.size()) + " members");
+    for (std::size_t m = 0; m < node.members.size(); ++m)
+      if (!node.member_poses[m].matrix().allFinite())
+        throw std::invalid_argument(who + ": the pose of member " + std::to_string(node.members[m]) +
+                                    " is not finite");
+    for (int i : node.members) {
+      if (node_of[i] >= 0)
+        throw std::invalid_argument(who + ": observation " + std::to_string(i) + " is also in local map " +
+                                    std::to_string(node_of[i]));
+      node_of[i] = static_cast<int>(k);
+    }
+  }
   for (int i = 0; i < n; ++i)
-    if (node_of[i] < 0) throw std::invalid_argument("buildTopologicalMap: an observation is in no local map");
+    if (node_of[i] < 0)
+      throw std::invalid_argument("buildTopologicalMap: observation " + std::to_string(i) + " is in no local map");
 
   std::vector<Eigen::Isometry3d> to_local(n);
   for (const LocalMapFrame& node : nodes)
@@ -129,18 +169,16 @@ TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const Weigh
   map.nodes = std::move(nodes);
   const int maps = static_cast<int>(map.nodes.size());
   std::vector<std::vector<TopologicalArc>> arcs_from(maps);  // arcs_from[A]: the arcs (A, B > A), by B
-#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
-  {
-    std::vector<CrossPair> pairs;
-#pragma omp for schedule(dynamic, 4)
-    for (int A = 0; A < maps; ++A) {
-      crossPairsOf(map.nodes[A], A, node_of, W, pairs);
-      for (std::size_t begin = 0, end; begin < pairs.size(); begin = end) {
-        for (end = begin + 1; end < pairs.size() && pairs[end].to == pairs[begin].to;) ++end;
-        arcs_from[A].push_back(makeArc(A, pairs, begin, end, to_local));
-      }
-    }
-  }
+  parallelForWithScratch(
+      std::size_t(maps), threads, 4, [] { return std::vector<CrossPair>(); },
+      [&](std::size_t a, std::vector<CrossPair>& pairs) {
+        const int A = static_cast<int>(a);
+        crossPairsOf(map.nodes[A], A, node_of, W, pairs);
+        for (std::size_t begin = 0, end; begin < pairs.size(); begin = end) {
+          for (end = begin + 1; end < pairs.size() && pairs[end].to == pairs[begin].to;) ++end;
+          arcs_from[A].push_back(makeArc(A, pairs, begin, end, to_local));
+        }
+      });
   for (auto& arcs : arcs_from) map.arcs.insert(map.arcs.end(), arcs.begin(), arcs.end());
   return map;
 }

@@ -7,6 +7,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <string>
 #include <vector>
 
 namespace obsgroup {
@@ -45,6 +46,16 @@ WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& memb
 /// The same with caller-owned scratch: `local_of` has W.rows() entries, all
 /// -1, and is left so; repeated calls then cost O(nnz of the members' columns).
 WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& members, std::vector<int>& local_of);
+
+/// Throws std::invalid_argument, its message starting with `who`, unless
+/// `members` are nodes of a graph of `n` nodes as every group is: not empty,
+/// ascending, distinct, each in [0, n). A caller's bad index is an error,
+/// never a read out of bounds.
+void checkMembers(const std::string& who, const std::vector<int>& members, Eigen::Index n);
+
+/// Throws std::invalid_argument, its message starting with `who`, unless W
+/// is square with `n` rows (one per observation).
+void checkWeightMatrixSize(const std::string& who, const WeightMatrix& W, Eigen::Index n);
 
 /// Connected components of W (the diagonal is ignored): each component sorted
 /// ascending, components ordered by their smallest node.

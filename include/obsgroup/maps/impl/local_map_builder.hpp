@@ -17,6 +17,7 @@
 #include <queue>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 
 namespace obsgroup {
@@ -187,7 +188,12 @@ template <typename PointT>
 LocalMap<PointT> LocalMapBuilder<PointT>::buildGroup(const std::vector<Observation<PointT>>& observations,
                                                      const pcl::Indices& group, const WeightMatrix& W,
                                                      const std::vector<Eigen::Isometry3d>& poses) const {
-  if (group.empty()) throw std::invalid_argument("LocalMapBuilder: empty group");
+  const std::string who = "LocalMapBuilder::build";
+  checkWeightMatrixSize(who, W, Eigen::Index(observations.size()));
+  checkMembers(who, group, Eigen::Index(observations.size()));
+  for (int i : group)
+    if (!observations[i].cloud)
+      throw std::invalid_argument(who + ": observation " + std::to_string(i) + " has no cloud (null pointer)");
   LocalMap<PointT> map;
   map.frame = initialFrame(group, W, poses);
   map.refinement.members = static_cast<int>(group.size()) - 1;
@@ -220,6 +226,7 @@ LocalMap<PointT> LocalMapBuilder<PointT>::buildGroup(const std::vector<Observati
 template <typename PointT>
 std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<Observation<PointT>>& observations,
                                                              const Partition& partition, const WeightMatrix& W) const {
+  checkWeightMatrixSize("LocalMapBuilder::build", W, Eigen::Index(observations.size()));
   std::vector<LocalMap<PointT>> maps(partition.groups.size());
   const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
   parallelFor(partition.groups.size(), threads_, [&](std::size_t g) {
