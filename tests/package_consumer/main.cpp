@@ -2,9 +2,12 @@
 // far away give two groups, each coloured with PCL's visualization module;
 // then the same three scans inserted one by one into an OnlineGrouping; the
 // same three scans as a CARMEN log, read with obsgroup::io; and, when given
-// one, a ROS bag (argv[1]) read with obsgroup::io's BagReader.
+// one, a ROS bag (argv[1]) read with obsgroup::io's BagReader. A caller's
+// mistakes reach it as exceptions: a throwing progress callback's own, and
+// std::invalid_argument for a local map of a group with an index out of range.
 #include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/io/ros_bag.h>
+#include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/observation_grouping.h>
 #include <obsgroup/online_grouping.h>
 
@@ -12,6 +15,7 @@
 #include <pcl/visualization/point_cloud_color_handlers.h>
 
 #include <cstdio>
+#include <stdexcept>
 #include <string>
 
 int main(int argc, char** argv) {
@@ -47,6 +51,25 @@ int main(int argc, char** argv) {
   const auto log_partition = from_log.compute();
   std::printf("package consumer: %zu scans read with obsgroup::io, %zu groups\n", read.scans.size(),
               log_partition.groups.size());
+  obsgroup::ObservationGrouping<pcl::PointXYZ> failing;
+  for (int k = 0; k < 50; ++k) failing.addObservation(line, obsgroup::pose2D(0.1 * k, 0, 0));
+  failing.setProgressCallback([](std::size_t, std::size_t) { throw std::runtime_error("stop from the callback"); });
+  bool callback_ok = false;
+  try {
+    failing.compute();
+  } catch (const std::runtime_error& e) {
+    callback_ok = std::string(e.what()) == "stop from the callback";
+  }
+  bool bad_group_ok = false;
+  try {
+    obsgroup::LocalMapBuilder<pcl::PointXYZ>().build(grouping.getObservations(), pcl::Indices{0, 1, 3},
+                                                     grouping.getWeightMatrix());
+  } catch (const std::invalid_argument& e) {
+    bad_group_ok = true;
+    std::printf("package consumer: a bad group is refused: %s\n", e.what());
+  }
+  std::printf("package consumer: the callback's exception %s\n", callback_ok ? "reached the caller" : "was lost");
+
   bool bag_ok = true;
   if (argc > 1) {
     const auto version = obsgroup::io::detectBag(argv[1]);
@@ -60,7 +83,7 @@ int main(int argc, char** argv) {
     bag_ok = version.has_value() && !bag.observations.empty() && !bag_partition.groups.empty();
   }
   return partition.groups.size() == 2 && online.getPartition().groups == partition.groups && colour.isCapable() && read.scans.size() == 3 &&
-                 log_partition.groups.size() == 2 && bag_ok
+                 log_partition.groups.size() == 2 && bag_ok && callback_ok && bad_group_ok
              ? 0
              : 1;
 }
