@@ -3,6 +3,10 @@
 # Macros, not functions: the targets and PCL's *_FOUND variables must reach the
 # caller (a second find_package(PCL ...) there skips what was found here).
 
+# The oldest PCL obsgroup builds with: pcl/types.h (pcl::Indices, pcl::index_t)
+# came with PCL 1.11.
+set(OBSGROUP_PCL_MINIMUM_VERSION 1.11)
+
 # obsgroup::core (graph, spectral, partition, sensed regions, topology):
 # Eigen, Spectra and OpenMP only.
 macro(obsgroup_find_core_dependencies)
@@ -40,7 +44,7 @@ endmacro()
 # obsgroup::io (the readers): PCL's io, zlib (gzip input), libpng (depth
 # images) and, when installed, libdeflate (a faster inflate).
 macro(obsgroup_find_io_dependencies)
-  obsgroup_find_pcl(1.10 REQUIRED COMPONENTS common io)
+  obsgroup_find_pcl(${OBSGROUP_PCL_MINIMUM_VERSION} REQUIRED COMPONENTS common io)
   find_package(ZLIB REQUIRED)
   find_package(PNG REQUIRED)
   find_package(PkgConfig REQUIRED)
@@ -93,9 +97,12 @@ macro(obsgroup_find_bag_dependencies)
 endmacro()
 
 # obsgroup::obsgroup (the PCL templates, local maps): the core's and PCL's.
+# OBSGROUP_PCL_TARGETS are what the installed headers include (a user's
+# PCL_NO_PRECOMPILE build compiles them); LZ4 is only the compiled library's
+# own (refinement's FLANN index), private to it.
 macro(obsgroup_find_pcl_dependencies)
-  obsgroup_find_pcl(1.10 REQUIRED COMPONENTS common kdtree search filters registration)
-  set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters pcl_registration)
+  obsgroup_find_pcl(${OBSGROUP_PCL_MINIMUM_VERSION} REQUIRED COMPONENTS common kdtree search filters)
+  set(OBSGROUP_PCL_TARGETS pcl_common pcl_kdtree pcl_search pcl_filters)
   # FLANN's index headers (refinement's nearest-point search, src/maps/refinement.cpp)
   # call LZ4 in their serialisation code; libflann-dev brings liblz4-dev along.
   find_library(OBSGROUP_LZ4_LIBRARY NAMES lz4 REQUIRED)

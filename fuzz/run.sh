@@ -14,7 +14,7 @@ seed=${OBSGROUP_FUZZ_SEED:-1}
 jobs=$(nproc)
 
 CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOBSGROUP_BUILD_FUZZERS=ON \
-  -DOBSGROUP_BUILD_TESTS=OFF -DOBSGROUP_BUILD_EXAMPLES=OFF > /dev/null
+  -DOBSGROUP_BUILD_TESTS=OFF -DOBSGROUP_BUILD_EXAMPLES=OFF -DOBSGROUP_BUILD_CLI=OFF > /dev/null
 cmake --build build-fuzz -j"$jobs" --target fuzz_carmen fuzz_pose_file fuzz_pcd fuzz_depth_png fuzz_sequence_text \
   fuzz_ros1_message fuzz_ros2_message > /dev/null
 
