@@ -15,6 +15,16 @@
 //   evaluate_grouping --model M [--split S] [parameters] [selection]
 //       one configuration: a line per dataset and a summary line, for sweeps.
 //
+//   evaluate_grouping --log LOG --labels LABELS.json [--log ... --labels ...] [parameters]
+//       real CARMEN logs with a room label per scan ({"names", "kinds",
+//       "labels"}: a region per scan, "room" or "corridor"): a line per log
+//       (groups, ARI, rooms found and pure) and a summary line.
+//
+//   evaluate_grouping --write-logs FOLDER [selection]
+//       writes the selected laser datasets as CARMEN logs (ROBOTLASER1, the
+//       poses the grouping sees) with their labels in the same JSON, to run
+//       `obsgroup partition` on them and look at its pictures.
+//
 // Run with --help for the parameters and the selection of datasets.
 
 #include "floor_plan.h"
@@ -23,6 +33,11 @@
 #include "to_cloud.h"
 
 #include <obsgroup/observation_grouping.h>
+#ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
+#include <obsgroup/io/carmen_reader.h>
+
+#include <nlohmann/json.hpp>
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -195,16 +210,17 @@ struct Result {
   double mean_group_size = 0.0;
   double ari = 0.0;
   int rooms_whole = 0, rooms = 0;
+  int rooms_found = 0, rooms_pure = 0;  ///< sim::scoreRooms: the measure of real logs with room labels
   double seconds = 0.0;  ///< ObservationGrouping::compute() alone, wall time
   std::size_t warnings = 0;
   std::string error;  ///< what compute() threw; the numbers are then meaningless
 };
 
-Result evaluate(const Dataset& d, const Configuration& c) {
-  Result r;
-  r.rooms = d.rooms;
+/// Groups `observations` with configuration `c`; throws what compute() throws.
+Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, const Configuration& c,
+                std::size_t* warnings = nullptr) {
   ObservationGrouping<pcl::PointXYZ> grouping;
-  for (const auto& o : d.observations) grouping.addObservation(o.cloud, o.pose);
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   grouping.setSensedSpaceModel(c.model);
   grouping.setRegionParameters(c.region);
   grouping.setMatchDistance(c.match_distance);
@@ -215,16 +231,23 @@ Result evaluate(const Dataset& d, const Configuration& c) {
   options.keep_eigenvectors = false;  // only the groups are measured
   grouping.setPartitionOptions(options);
   grouping.setNumberOfThreads(c.threads);
+  Partition p = grouping.compute();
+  if (warnings) *warnings = grouping.getWarnings().size();
+  return p;
+}
+
+Result evaluate(const Dataset& d, const Configuration& c) {
+  Result r;
+  r.rooms = d.rooms;
   Partition p;
   const auto start = std::chrono::steady_clock::now();
   try {
-    p = grouping.compute();
+    p = group(d.observations, c, &r.warnings);
   } catch (const std::exception& e) {
     r.error = e.what();
     return r;
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.warnings = grouping.getWarnings().size();
   r.groups = static_cast<int>(p.groups.size());
   r.mean_group_size = r.groups ? double(d.observations.size()) / r.groups : 0.0;
   r.ari = sim::adjustedRandIndex(d.places.of_pose, p.group_of);
@@ -232,13 +255,16 @@ Result evaluate(const Dataset& d, const Configuration& c) {
   for (std::size_t i = 0; i < d.places.of_pose.size(); ++i)
     if (d.places.is_room[d.places.of_pose[i]]) groups_of_room[d.places.of_pose[i]].insert(p.group_of[i]);
   for (const auto& [room, groups] : groups_of_room) r.rooms_whole += groups.size() == 1;
+  const sim::RoomScores scores = sim::scoreRooms(d.places.of_pose, d.places.is_room, p.group_of);
+  r.rooms_found = scores.found;
+  r.rooms_pure = scores.pure;
   return r;
 }
 
 /// Results of one configuration over the datasets.
 struct Summary {
   double mean_ari = 0.0;
-  int rooms_whole = 0, rooms = 0;
+  int rooms_whole = 0, rooms = 0, rooms_found = 0, rooms_pure = 0;
   double worst_ari = 1.0;
   std::string worst;  ///< the dataset of the worst ARI
   double seconds = 0.0;
@@ -260,6 +286,8 @@ Summary summarize(const std::vector<Dataset>& datasets, const std::vector<Result
     ++s.datasets;
     s.mean_ari += r.ari;
     s.rooms_whole += r.rooms_whole;
+    s.rooms_found += r.rooms_found;
+    s.rooms_pure += r.rooms_pure;
     s.rooms += r.rooms;
     if (r.ari < s.worst_ari || s.worst.empty()) s.worst_ari = r.ari, s.worst = datasets[k].name();
   }
@@ -284,20 +312,117 @@ int evaluateOneConfiguration(const std::vector<Dataset>& datasets, const Configu
       std::cout << format("%-24s error: %s\n", d.name().c_str(), errorText(r.error).c_str());
     else
       std::cout << format("%-24s %4zu scans  drift %4.2f m  groups %4d (size %5.1f)  ARI %6.3f  rooms whole %2d/%-2d"
-                          "  %6.2f s%s\n",
+                          "  found %2d  pure %2d  %6.2f s%s\n",
                           d.name().c_str(), d.observations.size(), d.drift_rms, r.groups, r.mean_group_size, r.ari,
-                          r.rooms_whole, r.rooms, r.seconds,
+                          r.rooms_whole, r.rooms, r.rooms_found, r.rooms_pure, r.seconds,
                           r.warnings ? format("  (%zu warnings)", r.warnings).c_str() : "");
     std::cout.flush();
     results.push_back(r);
   }
   const Summary s = summarize(datasets, results);
   const std::string worst = s.datasets ? format("%.3f (%s)", s.worst_ari, s.worst.c_str()) : std::string("–");
-  std::cout << format("summary %s: mean ARI %.3f  rooms whole %d/%d  worst ARI %s  %.1f s%s\n", c.parameters().c_str(),
-                      s.mean_ari, s.rooms_whole, s.rooms, worst.c_str(), s.seconds,
+  std::cout << format("summary %s: mean ARI %.3f  rooms whole %d/%d  found %d  pure %d  worst ARI %s  %.1f s%s\n",
+                      c.parameters().c_str(), s.mean_ari, s.rooms_whole, s.rooms, s.rooms_found, s.rooms_pure,
+                      worst.c_str(), s.seconds,
                       s.errors ? format("  %d ERRORS", s.errors).c_str() : "");
   return s.errors ? 1 : 0;
 }
+
+/// Writes the laser datasets of `buildings` as CARMEN logs and their places
+/// as labels (the format of --labels): FOLDER/BUILDING_SENSOR_POSES.clf and
+/// FOLDER/BUILDING_labels.json.
+int writeLogs(const std::string& folder, const std::vector<std::string>& buildings,
+              const std::vector<sim::Sensor>& sensors, const std::vector<PoseSource>& pose_sources) {
+  for (const std::string& key : buildings) {
+    const sim::Building building = sim::makeBuilding(key);
+    const sim::Places places = sim::placesAlong(building.plan, building.route, kStretchLength);
+    {
+      std::ofstream labels(folder + "/" + key + "_labels.json");
+      labels << "{\"names\": [";
+      for (std::size_t p = 0; p < places.names.size(); ++p) labels << (p ? ", " : "") << '"' << places.names[p] << '"';
+      labels << "],\n \"kinds\": [";
+      for (std::size_t p = 0; p < places.is_room.size(); ++p)
+        labels << (p ? ", " : "") << (places.is_room[p] ? "\"room\"" : "\"corridor\"");
+      labels << "],\n \"labels\": [";
+      for (std::size_t i = 0; i < places.of_pose.size(); ++i) labels << (i ? ", " : "") << places.of_pose[i];
+      labels << "]}\n";
+      if (!labels) throw std::runtime_error("cannot write into " + folder);
+    }
+    std::vector<Eigen::Isometry3d> truth;
+    for (const sim::Pose2D& pose : building.route) truth.push_back(sim::toIsometry(pose));
+    const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
+    for (sim::Sensor sensor : sensors) {
+      if (sensor == sim::Sensor::Depth) continue;  // not a CARMEN log
+      const sim::LaserModel laser = sensor == sim::Sensor::Laser360 ? sim::laser360() : sim::laser180();
+      const double step = laser.full_turn ? laser.field_of_view / laser.beams : laser.field_of_view / (laser.beams - 1);
+      for (PoseSource source : pose_sources) {
+        const std::string path = folder + "/" + key + "_" + sim::toString(sensor) + "_" + toString(source) + ".clf";
+        std::ofstream out(path);
+        out << "# " << building.title << "; " << sim::describe(sensor) << ", " << toString(source)
+            << " poses (obsgroup's scan simulator, examples/evaluate_grouping.cpp)\n";
+        for (std::size_t k = 0; k < building.route.size(); ++k) {
+          const auto ranges = building.plan.scan(building.route[k], laser, k);  // the seed of makeDatasets
+          const Eigen::Isometry3d& pose = source == PoseSource::Exact ? truth[k] : drifted[k];
+          const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
+          out << format("ROBOTLASER1 0 %.9f %.9f %.9f %.3f 0.01 0 %zu", laser.beamAngle(0, ranges.size()),
+                        laser.field_of_view, step, laser.max_range, ranges.size());
+          for (double r : ranges) out << format(" %.3f", r);
+          const double x = pose.translation().x(), y = pose.translation().y();
+          out << format(" 0 %.6f %.6f %.6f %.6f %.6f %.6f 0 0 0 0 0 %.3f sim %.3f\n", x, y, yaw, x, y, yaw,
+                        1000.0 + 0.5 * double(k), 0.5 * double(k));
+        }
+        if (!out) throw std::runtime_error("cannot write " + path);
+        std::cout << "wrote " << path << "\n";
+      }
+    }
+  }
+  return 0;
+}
+
+/// A real log with a room label per scan.
+struct LabelledLog {
+  std::string log, labels;
+};
+
+#ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
+/// Groups each log as the command would (its default laser messages) and
+/// scores the groups against the labels: a line per log and a summary line.
+int evaluateLabelledLogs(const std::vector<LabelledLog>& logs, const Configuration& c) {
+  int rooms = 0, found = 0, pure = 0, errors = 0;
+  for (const LabelledLog& l : logs) {
+    try {
+      const io::CarmenLog log = io::readCarmenLog(l.log);
+      std::vector<Observation<pcl::PointXYZ>> observations;
+      for (const io::LaserScan& scan : log.scans) observations.push_back({io::scanToCloud(scan), scan.laser_pose});
+      const nlohmann::json labels = nlohmann::json::parse(std::ifstream(l.labels));
+      const std::vector<int> place_of = labels.at("labels").get<std::vector<int>>();
+      if (place_of.size() != observations.size())
+        throw std::invalid_argument(l.labels + ": " + std::to_string(place_of.size()) + " labels for " +
+                                    std::to_string(observations.size()) + " scans of " + l.log);
+      const std::vector<std::string> kinds = labels.at("kinds").get<std::vector<std::string>>();
+      std::vector<bool> is_room;
+      for (const std::string& kind : kinds) is_room.push_back(kind == "room");
+      const auto start = std::chrono::steady_clock::now();
+      const Partition p = group(observations, c);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const sim::RoomScores scores = sim::scoreRooms(place_of, is_room, p.group_of);
+      rooms += scores.rooms;
+      found += scores.found;
+      pure += scores.pure;
+      std::cout << format("%-40s %5zu scans  groups %4zu  ARI %6.3f  rooms found %2d/%-2d  pure %2d/%-2d  %6.2f s\n",
+                          l.log.c_str(), observations.size(), p.groups.size(),
+                          sim::adjustedRandIndex(place_of, p.group_of), scores.found, scores.rooms, scores.pure,
+                          scores.rooms, seconds);
+    } catch (const std::exception& e) {
+      ++errors;
+      std::cout << format("%-40s error: %s\n", l.log.c_str(), e.what());
+    }
+  }
+  std::cout << format("summary %s: rooms found %d/%d  pure %d/%d%s\n", c.parameters().c_str(), found, rooms, pure,
+                      rooms, errors ? format("  %d ERRORS", errors).c_str() : "");
+  return errors ? 1 : 0;
+}
+#endif
 
 /// The page's generated section: the datasets, a summary per configuration
 /// and a table per dataset.
@@ -325,8 +450,8 @@ std::string page(const std::vector<Dataset>& datasets, const std::vector<Configu
 
   out << "### Summary over the " << datasets.size() << " datasets\n\n"
       << "| configuration | mean ARI | exact / drifted poses | 360° laser / 180° laser / depth camera "
-         "| rooms whole | worst ARI (dataset) | time (s) |\n"
-      << "|---|---|---|---|---|---|---|\n";
+         "| rooms whole | rooms found | rooms pure | worst ARI (dataset) | time (s) |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t c = 0; c < configurations.size(); ++c) {
     const Summary all = summarize(datasets, results[c]);
     const auto ari_where = [&](const std::function<bool(const Dataset&)>& include) {
@@ -339,7 +464,7 @@ std::string page(const std::vector<Dataset>& datasets, const std::vector<Configu
         << ari_where(of_poses(PoseSource::Exact)) << " / " << ari_where(of_poses(PoseSource::Drift)) << " | "
         << ari_where(of_sensor(sim::Sensor::Laser360)) << " / " << ari_where(of_sensor(sim::Sensor::Laser180))
         << " / " << ari_where(of_sensor(sim::Sensor::Depth)) << " | " << all.rooms_whole << " of " << all.rooms
-        << " | " << format("%.2f", all.worst_ari) << " (" << all.worst << ") | " << format("%.1f", all.seconds)
+        << " | " << all.rooms_found << " | " << all.rooms_pure << " | " << format("%.2f", all.worst_ari) << " (" << all.worst << ") | " << format("%.1f", all.seconds)
         << (all.errors ? format(" (%d failed)", all.errors) : std::string()) << " |\n";
   }
 
@@ -364,16 +489,17 @@ std::string page(const std::vector<Dataset>& datasets, const std::vector<Configu
   for (std::size_t k = 0; k < datasets.size(); ++k) {
     const Dataset& d = datasets[k];
     out << "\n#### " << d.heading() << "\n\n"
-        << "| configuration | groups | mean group size | ARI vs places | rooms whole | time (s) |\n"
-        << "|---|---|---|---|---|---|\n";
+        << "| configuration | groups | mean group size | ARI vs places | rooms whole | rooms found | rooms pure "
+           "| time (s) |\n"
+        << "|---|---|---|---|---|---|---|---|\n";
     for (std::size_t c = 0; c < configurations.size(); ++c) {
       const Result& r = results[c][k];
       if (!r.error.empty())
-        out << "| " << configurations[c].label() << " | failed: " << errorText(r.error) << " | | | | |\n";
+        out << "| " << configurations[c].label() << " | failed: " << errorText(r.error) << " | | | | | | |\n";
       else
         out << "| " << configurations[c].label() << " | " << r.groups << " | " << format("%.1f", r.mean_group_size)
             << " | " << format("%.3f", r.ari) << " | " << r.rooms_whole << " of " << r.rooms << " | "
-            << format("%.2f", r.seconds) << " |\n";
+            << r.rooms_found << " | " << r.rooms_pure << " | " << format("%.2f", r.seconds) << " |\n";
     }
   }
   out << format("\n(datasets generated in %.1f s, evaluated in %.1f s", generation_seconds, seconds)
@@ -411,7 +537,11 @@ const char* kUsage =
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --min-group-size N  --ncut-threshold X  --threads N (0: all cores)\n"
     "selection (defaults: all):\n"
-    "  --datasets office,loop,rooms20  --sensors laser360,laser180,depth  --poses exact,drift\n";
+    "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth  --poses exact,drift\n"
+    "real logs instead of the simulated buildings (each --log with its --labels, in order):\n"
+    "  --log LOG --labels LABELS.json\n"
+    "the selected laser datasets as CARMEN logs with their labels, for obsgroup partition and --log:\n"
+    "  --write-logs FOLDER\n";
 
 }  // namespace
 
@@ -423,6 +553,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> buildings = sim::buildingKeys();
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
   std::vector<PoseSource> pose_sources{PoseSource::Exact, PoseSource::Drift};
+  std::vector<std::string> logs, label_files;
+  std::string write_logs;
   try {
     RegionParameters& region = configuration.region;
     using Setter = std::function<void(const std::string& flag, const std::string& value)>;
@@ -446,6 +578,9 @@ int main(int argc, char** argv) {
         {"--min-group-size", integer(configuration.min_group_size)},
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--threads", integer(configuration.threads)},
+        {"--write-logs", [&](const std::string&, const std::string& v) { write_logs = v; }},
+        {"--log", [&](const std::string&, const std::string& v) { logs.push_back(v); }},
+        {"--labels", [&](const std::string&, const std::string& v) { label_files.push_back(v); }},
         {"--datasets",
          [&](const std::string&, const std::string& v) {
            buildings = splitList(v);
@@ -475,10 +610,32 @@ int main(int argc, char** argv) {
     if ((model || split) && !output.empty())
       throw std::invalid_argument("--output writes the page; it takes no --model or --split");
     if (buildings.empty() || sensors.empty() || pose_sources.empty()) throw std::invalid_argument("nothing selected");
+    if (logs.size() != label_files.size()) throw std::invalid_argument("each --log needs its --labels");
+#ifndef OBSGROUP_EVALUATE_LABELLED_LOGS
+    if (!logs.empty()) throw std::invalid_argument("built without the readers or nlohmann-json: no --log");
+#endif
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n" << kUsage;
     return 2;
   }
+  if (!write_logs.empty()) {
+    try {
+      return writeLogs(write_logs, buildings, sensors, pose_sources);
+    } catch (const std::exception& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+#ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
+  if (!logs.empty()) {
+    const ObservationGrouping<pcl::PointXYZ> defaults;
+    configuration.model = model.value_or(defaults.getSensedSpaceModel());
+    configuration.split = split.value_or(defaults.getSplitCriterion());
+    std::vector<LabelledLog> labelled;
+    for (std::size_t k = 0; k < logs.size(); ++k) labelled.push_back({logs[k], label_files[k]});
+    return evaluateLabelledLogs(labelled, configuration);
+  }
+#endif
 
   const auto start = std::chrono::steady_clock::now();
   const std::vector<Dataset> datasets = makeDatasets(buildings, sensors, pose_sources);

@@ -599,3 +599,160 @@ std::vector<Pose2D> twentyRoomBuildingSecondVisitRoute(int count) {
 }
 
 }  // namespace obsgroup::sim
+
+namespace obsgroup::sim {
+
+namespace {
+
+/// A small room of smallRoomsBuilding(): x0..x1 along the corridor, its
+/// door wall at y = front, its back wall at y = back, its door centred at x = door.
+struct SmallRoom {
+  double x0, x1, front, back, door;
+};
+
+/// Four rows of small rooms (3 to 5 m wide, 3.5 to 4.5 m deep), as in the
+/// Intel lab: the outer rows face the ring from outside, the block's rows
+/// from inside. Widths and doors differ so that no two rooms look alike.
+std::vector<SmallRoom> smallRooms() {
+  std::vector<SmallRoom> rooms;
+  const auto row = [&rooms](std::vector<double> walls, double front, double back) {
+    for (std::size_t r = 0; r + 1 < walls.size(); ++r) {
+      const double x0 = walls[r], x1 = walls[r + 1];
+      // The door near one end or the middle, in turn.
+      const double offset = r % 3 == 0 ? 0.9 : r % 3 == 1 ? (x1 - x0) / 2 : x1 - x0 - 0.9;
+      rooms.push_back({x0, x1, front, back, x0 + offset});
+    }
+  };
+  row({0, 4, 8.5, 12, 16, 21, 25, 28.5, 33, 36, 40}, 4.0, 0.0);       // south outer row
+  row({3, 7, 11.5, 15, 19.5, 24, 27.5, 32, 37}, 6.5, 10.5);           // block, facing south
+  row({3, 6.5, 11, 15, 18.5, 23, 27, 32.5, 37}, 19.5, 15.0);          // block, facing north
+  row({0, 3.5, 8, 12.5, 16, 20, 24.5, 28, 32, 36, 40}, 22.0, 26.0);   // north outer row
+  return rooms;
+}
+
+}  // namespace
+
+FloorPlan smallRoomsBuilding() {
+  FloorPlan plan;
+  plan.addWallX(0.0, -0.1, 40.1);
+  plan.addWallX(26.0, -0.1, 40.1);
+  plan.addWallY(0.0, 0.0, 26.0);
+  plan.addWallY(40.0, 0.0, 26.0);
+  const std::vector<SmallRoom> rooms = smallRooms();
+  for (double front : {4.0, 6.5, 19.5, 22.0}) {
+    std::vector<std::pair<double, double>> doors;
+    for (const SmallRoom& r : rooms)
+      if (r.front == front) doors.emplace_back(r.door - 0.5, r.door + 0.5);
+    const bool block = front == 6.5 || front == 19.5;
+    plan.addWallX(front, block ? 2.9 : 0.0, block ? 37.1 : 40.0, doors);
+  }
+  // The block's closed middle (labs with no door onto the ring) and its ends.
+  plan.addWallX(10.5, 3.0, 37.0);
+  plan.addWallX(15.0, 3.0, 37.0);
+  plan.addWallY(3.0, 6.5, 19.5);
+  plan.addWallY(37.0, 6.5, 19.5);
+  for (const SmallRoom& r : rooms)
+    if (r.x0 != 0.0 && r.x0 != 3.0) plan.addWallY(r.x0, std::min(r.front, r.back), std::max(r.front, r.back));
+  // A desk or a cupboard in every room, against its back wall.
+  for (std::size_t k = 0; k < rooms.size(); ++k) {
+    const SmallRoom& r = rooms[k];
+    const double inward = r.back > r.front ? 1.0 : -1.0;
+    const double width = std::min(r.x1 - r.x0 - 1.2, 1.0 + 0.3 * double(k % 4));
+    const double x = k % 2 ? r.x0 + 0.3 : r.x1 - 0.3 - width;
+    const double face = r.back - inward * 0.15, depth = 0.5 + 0.1 * double(k % 3);
+    plan.addBox(x, std::min(face, face - inward * depth), x + width, std::max(face, face - inward * depth));
+  }
+  for (std::size_t k = 0; k < rooms.size(); ++k) {
+    const SmallRoom& r = rooms[k];
+    plan.addRoom("room " + std::to_string(k + 1), r.x0, std::min(r.front, r.back), r.x1, std::max(r.front, r.back));
+  }
+  plan.addRoom("south corridor", 0.0, 4.0, 40.0, 6.5);
+  plan.addRoom("north corridor", 0.0, 19.5, 40.0, 22.0);
+  plan.addRoom("west corridor", 0.0, 6.5, 3.0, 19.5);
+  plan.addRoom("east corridor", 37.0, 6.5, 40.0, 19.5);
+  return plan;
+}
+
+std::vector<Pose2D> smallRoomsRoute(int count) {
+  const std::vector<SmallRoom> rooms = smallRooms();
+  std::vector<Eigen::Vector2d> waypoints;
+  // Into the doorway and a step inside, turning to face the room's ends,
+  // then back out: the room is looked into, never walked round.
+  const auto look_into = [&waypoints](const SmallRoom& r, double lane) {
+    const double inward = r.back > r.front ? 1.0 : -1.0;
+    const double step = r.front + inward * 1.1, deeper = r.front + inward * 1.5;
+    const double left = std::max(r.x0 + 0.7, r.door - 0.8), right = std::min(r.x1 - 0.7, r.door + 0.8);
+    waypoints.insert(waypoints.end(), {{r.door, lane}, {r.door, step}, {left, deeper}, {right, deeper},
+                                        {r.door, step}, {r.door, lane}});
+  };
+  constexpr double south_y = 5.25, north_y = 20.75, west_x = 1.5, east_x = 38.5;
+  std::vector<const SmallRoom*> south, north;
+  for (const SmallRoom& r : rooms) (r.front < 13.0 ? south : north).push_back(&r);
+  std::sort(south.begin(), south.end(), [](const SmallRoom* a, const SmallRoom* b) { return a->door < b->door; });
+  std::sort(north.begin(), north.end(), [](const SmallRoom* a, const SmallRoom* b) { return a->door > b->door; });
+  waypoints.emplace_back(west_x, south_y);
+  for (const SmallRoom* r : south) look_into(*r, south_y);
+  waypoints.emplace_back(east_x, south_y);
+  waypoints.emplace_back(east_x, north_y);
+  for (const SmallRoom* r : north) look_into(*r, north_y);
+  waypoints.emplace_back(west_x, north_y);
+  waypoints.emplace_back(west_x, south_y);  // the loop closes
+  return evenlySpaced(waypoints, count);
+}
+
+FloorPlan hallBuilding() {
+  FloorPlan plan;
+  // A 24 x 16 m hall (x 0..24, y 0..16), four 6 x 5 m rooms off its north
+  // side, a 3 m corridor along its east side with two rooms beyond it.
+  plan.addWallX(0.0, -0.1, 33.1);
+  plan.addWallX(21.0, -0.1, 33.1);
+  plan.addWallY(0.0, 0.0, 21.0);
+  plan.addWallY(33.0, 0.0, 21.0);
+  plan.addWallX(16.0, 0.0, 24.0, {{2.5, 3.5}, {9.0, 10.0}, {14.5, 15.5}, {20.0, 21.0}});
+  for (double x : {6.0, 12.0, 18.0}) plan.addWallY(x, 16.0, 21.0);
+  plan.addWallY(24.0, 0.0, 21.0, {{7.0, 9.0}, {17.5, 18.5}});  // a wide opening onto the corridor, a door to room 4
+  plan.addWallY(27.0, 0.0, 21.0, {{3.5, 4.5}, {12.5, 13.5}});
+  plan.addWallX(9.0, 27.0, 33.0);
+  // Pillars and benches in the hall, a cupboard in each room.
+  for (double x : {6.0, 12.0, 18.0})
+    for (double y : {5.5, 10.5}) plan.addBox(x - 0.25, y - 0.25, x + 0.25, y + 0.25);
+  plan.addBox(1.0, 0.3, 3.5, 0.8);
+  plan.addBox(16.3, 15.2, 18.7, 15.7);
+  plan.addBox(0.3, 19.5, 1.8, 20.7);
+  plan.addBox(10.5, 20.2, 11.7, 20.7);
+  plan.addBox(12.3, 16.3, 13.0, 17.8);
+  plan.addBox(22.0, 20.2, 23.7, 20.7);
+  plan.addBox(31.5, 1.0, 32.7, 3.5);
+  plan.addBox(29.0, 20.2, 31.5, 20.7);
+  plan.addRoom("hall", 0.0, 0.0, 24.0, 16.0);
+  for (int k = 0; k < 4; ++k) plan.addRoom("room " + std::to_string(k + 1), 6.0 * k, 16.0, 6.0 * (k + 1), 21.0);
+  plan.addRoom("east corridor", 24.0, 0.0, 27.0, 21.0);
+  plan.addRoom("room 5", 27.0, 0.0, 33.0, 9.0);
+  plan.addRoom("room 6", 27.0, 9.0, 33.0, 21.0);
+  return plan;
+}
+
+std::vector<Pose2D> hallBuildingRoute(int count) {
+  std::vector<Eigen::Vector2d> waypoints;
+  // Lanes across the hall (x 1.5 to 22.5, every 3.5 m of y), clear of the pillars.
+  const double lanes[] = {2.0, 8.0, 13.0};
+  for (int k = 0; k < 3; ++k) {
+    const bool east = k % 2 == 0;
+    waypoints.emplace_back(east ? 1.5 : 22.5, lanes[k]);
+    waypoints.emplace_back(east ? 22.5 : 1.5, lanes[k]);
+  }
+  // Round each north room (through its door at x = 3, 9.5, 15, 20.5).
+  for (double door : {3.0, 9.5, 15.0, 20.5}) {
+    const double x0 = std::floor(door / 6.0) * 6.0;
+    waypoints.insert(waypoints.end(), {{door, 14.5}, {door, 17.2}, {x0 + 4.6, 17.4}, {x0 + 4.6, 19.6},
+                                        {x0 + 2.2, 19.6}, {x0 + 1.4, 17.4}, {door, 17.2}, {door, 14.5}});
+  }
+  // Out into the corridor, down it with a look into each of its rooms, and back.
+  waypoints.insert(waypoints.end(), {{22.5, 8.0}, {25.5, 8.0}, {25.5, 18.0}, {25.5, 13.0}, {28.5, 13.0},
+                                      {31.5, 11.0}, {31.5, 18.5}, {28.5, 18.5}, {28.5, 13.0}, {25.5, 13.0},
+                                      {25.5, 4.0}, {28.5, 4.0}, {31.0, 6.5}, {28.5, 7.5}, {28.5, 4.0},
+                                      {25.5, 4.0}, {25.5, 8.0}, {22.5, 8.0}, {12.0, 8.0}});
+  return evenlySpaced(waypoints, count);
+}
+
+}  // namespace obsgroup::sim

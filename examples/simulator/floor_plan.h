@@ -173,4 +173,26 @@ std::vector<Pose2D> twentyRoomBuildingRoute(int count = 600);
 /// run 1 and further from its walls. `count` poses.
 std::vector<Pose2D> twentyRoomBuildingSecondVisitRoute(int count = 300);
 
+/// A building of small rooms like the Intel lab's: a 2.5 m corridor ring
+/// (40 x 26 m) with 36 rooms 3 to 5 m wide and 4 or 4.5 m deep on both of
+/// its sides, each with one 1 m door and a desk or cupboard. The rooms are
+/// "room 1" to "room 36"; the ring is "south corridor", "north corridor",
+/// "west corridor" and "east corridor".
+FloorPlan smallRoomsBuilding();
+/// A route round the ring of smallRoomsBuilding() that looks into every room
+/// from its doorway, a step inside, turning to face the room's ends, and
+/// never walks round it (as a robot mapping the Intel lab did); the loop
+/// closes. `count` poses.
+std::vector<Pose2D> smallRoomsRoute(int count = 900);
+
+/// A hall larger than a depth camera's reach and the visibility model's
+/// range: an open 24 x 16 m hall with six pillars, four 6 x 5 m rooms off
+/// its north side, and a 3 m corridor along its east side (a wide opening
+/// from the hall) with two rooms beyond it. Places: "hall", "room 1" to
+/// "room 6", "east corridor".
+FloorPlan hallBuilding();
+/// Three lanes across the hall, once round each north room, then down the
+/// corridor into its rooms and back into the hall. `count` poses.
+std::vector<Pose2D> hallBuildingRoute(int count = 400);
+
 }  // namespace obsgroup::sim

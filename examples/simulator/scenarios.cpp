@@ -22,10 +22,16 @@ Building makeBuilding(const std::string& key) {
   if (key == "rooms20")
     return {key, "Twenty rooms around a loop: a corridor ring, rooms inside and outside it", twentyRoomBuilding(),
             twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)};
-  throw std::invalid_argument("unknown building '" + key + "' (office, loop or rooms20)");
+  if (key == "smallrooms")
+    return {key, "Small rooms looked into from the door: a corridor ring, 36 rooms of 3 to 5 m", smallRoomsBuilding(),
+            smallRoomsRoute(900), {}};
+  if (key == "hall")
+    return {key, "A hall larger than the sensors' reach, with rooms and a corridor off it", hallBuilding(),
+            hallBuildingRoute(400), {}};
+  throw std::invalid_argument("unknown building '" + key + "' (office, loop, rooms20, smallrooms or hall)");
 }
 
-std::vector<std::string> buildingKeys() { return {"office", "loop", "rooms20"}; }
+std::vector<std::string> buildingKeys() { return {"office", "loop", "rooms20", "smallrooms", "hall"}; }
 
 std::string toString(Sensor sensor) {
   switch (sensor) {
@@ -109,6 +115,35 @@ Places placesAlong(const FloorPlan& plan, const std::vector<Pose2D>& route, doub
   }
   for (const auto& key : keys) places.of_pose.push_back(place_of_key.at(key));
   return places;
+}
+
+RoomScores scoreRooms(const std::vector<int>& place_of, const std::vector<bool>& is_room,
+                      const std::vector<int>& group_of) {
+  if (place_of.size() != group_of.size())
+    throw std::invalid_argument("scoreRooms: one place and one group per observation expected");
+  const auto room = [&](int place) { return place >= 0 && std::size_t(place) < is_room.size() && is_room[place]; };
+  std::map<int, std::map<int, int>> groups_of_room;  // room -> group -> observations
+  std::map<int, std::map<int, int>> rooms_of_group;  // group -> room -> observations
+  for (std::size_t i = 0; i < place_of.size(); ++i) {
+    if (!room(place_of[i])) continue;
+    ++groups_of_room[place_of[i]][group_of[i]];
+    ++rooms_of_group[group_of[i]][place_of[i]];
+  }
+  RoomScores scores;
+  for (const auto& [place, groups] : groups_of_room) {
+    ++scores.rooms;
+    int total = 0, best = 0, best_group = -1;
+    for (const auto& [group, n] : groups) {
+      total += n;
+      if (n > best) best = n, best_group = group;
+    }
+    int in_best = 0;
+    for (const auto& [other, n] : rooms_of_group.at(best_group)) in_best += n;
+    scores.whole += groups.size() == 1;
+    scores.pure += groups.size() == 1 && rooms_of_group.at(best_group).size() == 1;
+    scores.found += 10 * best >= 9 * total && 10 * best >= 9 * in_best;
+  }
+  return scores;
 }
 
 Eigen::Isometry3d toIsometry(const Pose2D& pose, double z) {

@@ -16,7 +16,7 @@ namespace obsgroup::sim {
 
 /// A floor plan and the routes a robot takes through it.
 struct Building {
-  std::string key;    ///< short name for command lines: "office", "loop", "rooms20"
+  std::string key;    ///< short name for command lines: "office", "loop", "rooms20", ...
   std::string title;  ///< for reports
   FloorPlan plan;
   std::vector<Pose2D> route;        ///< run 1: the route its maps are built from
@@ -25,8 +25,10 @@ struct Building {
 
 /// The buildings by key: "office" (office(), officeRoute(150),
 /// officeSecondVisitRoute(40)), "loop" (loopBuilding(), loopBuildingRoute(300),
-/// loopBuildingSecondVisitRoute(70)) and "rooms20" (twentyRoomBuilding(),
-/// twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)).
+/// loopBuildingSecondVisitRoute(70)), "rooms20" (twentyRoomBuilding(),
+/// twentyRoomBuildingRoute(600), twentyRoomBuildingSecondVisitRoute(140)),
+/// "smallrooms" (smallRoomsBuilding(), smallRoomsRoute(900)) and "hall"
+/// (hallBuilding(), hallBuildingRoute(400)); the last two have no second visit.
 /// Throws std::invalid_argument for another key.
 Building makeBuilding(const std::string& key);
 /// The keys of makeBuilding, smallest building first.
@@ -66,6 +68,23 @@ Eigen::Isometry3d toIsometry(const Pose2D& pose, double z = 0.0);
 /// 2% of its length in x and y and 1 degree per metre in heading (the model
 /// of evaluate_local_maps). The first pose is kept; deterministic for a seed.
 std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed);
+
+/// How well groups match rooms, as a user checks a map against a floor
+/// plan's rooms (corridor observations may join any room's group):
+/// a room is *found* when at least 90% of its observations are in one group
+/// and at least 90% of that group's room observations are this room's; it
+/// is *pure* when all of its observations are in one group holding no
+/// observation of another room.
+struct RoomScores {
+  int rooms = 0;  ///< rooms with at least one observation
+  int found = 0;
+  int pure = 0;
+  int whole = 0;  ///< all of the room's observations in one group (which may hold other rooms)
+};
+/// `place_of[i]` is observation i's place (or -1: no label), `is_room[place]`
+/// whether the place is a room; `group_of[i]` its group.
+RoomScores scoreRooms(const std::vector<int>& place_of, const std::vector<bool>& is_room,
+                      const std::vector<int>& group_of);
 
 /// Adjusted Rand index of two labellings (Hubert and Arabie): 1 when they
 /// are the same partition, about 0 for a chance agreement.
