@@ -384,45 +384,124 @@ struct LabelledLog {
   std::string log, labels;
 };
 
+/// A labelled log read: its scans as the command reads them, its labels.
+struct LabelledDataset {
+  std::string name;
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  std::vector<int> place_of;
+  std::vector<bool> is_room;
+};
+
 #ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
-/// Groups each log as the command would (its default laser messages) and
-/// scores the groups against the labels: a line per log and a summary line.
-int evaluateLabelledLogs(const std::vector<LabelledLog>& logs, const Configuration& c) {
+LabelledDataset readLabelledLog(const LabelledLog& l) {
+  LabelledDataset d;
+  d.name = l.log;
+  const io::CarmenLog log = io::readCarmenLog(l.log);  // the command's default laser messages
+  for (const io::LaserScan& scan : log.scans) d.observations.push_back({io::scanToCloud(scan), scan.laser_pose});
+  const nlohmann::json labels = nlohmann::json::parse(std::ifstream(l.labels));
+  d.place_of = labels.at("labels").get<std::vector<int>>();
+  if (d.place_of.size() != d.observations.size())
+    throw std::invalid_argument(l.labels + ": " + std::to_string(d.place_of.size()) + " labels for " +
+                                std::to_string(d.observations.size()) + " scans of " + l.log);
+  for (const std::string& kind : labels.at("kinds").get<std::vector<std::string>>()) d.is_room.push_back(kind == "room");
+  return d;
+}
+#else
+LabelledDataset readLabelledLog(const LabelledLog&) {
+  throw std::invalid_argument("built without the readers or nlohmann-json: no --log");
+}
+#endif
+
+/// Groups each labelled log and scores the groups against its labels: a
+/// line per log and a summary line.
+int evaluateLabelledLogs(const std::vector<LabelledDataset>& logs, const Configuration& c) {
   int rooms = 0, found = 0, pure = 0, errors = 0;
-  for (const LabelledLog& l : logs) {
+  for (const LabelledDataset& d : logs) {
     try {
-      const io::CarmenLog log = io::readCarmenLog(l.log);
-      std::vector<Observation<pcl::PointXYZ>> observations;
-      for (const io::LaserScan& scan : log.scans) observations.push_back({io::scanToCloud(scan), scan.laser_pose});
-      const nlohmann::json labels = nlohmann::json::parse(std::ifstream(l.labels));
-      const std::vector<int> place_of = labels.at("labels").get<std::vector<int>>();
-      if (place_of.size() != observations.size())
-        throw std::invalid_argument(l.labels + ": " + std::to_string(place_of.size()) + " labels for " +
-                                    std::to_string(observations.size()) + " scans of " + l.log);
-      const std::vector<std::string> kinds = labels.at("kinds").get<std::vector<std::string>>();
-      std::vector<bool> is_room;
-      for (const std::string& kind : kinds) is_room.push_back(kind == "room");
       const auto start = std::chrono::steady_clock::now();
-      const Partition p = group(observations, c);
+      const Partition p = group(d.observations, c);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const sim::RoomScores scores = sim::scoreRooms(place_of, is_room, p.group_of);
+      const sim::RoomScores scores = sim::scoreRooms(d.place_of, d.is_room, p.group_of);
       rooms += scores.rooms;
       found += scores.found;
       pure += scores.pure;
       std::cout << format("%-40s %5zu scans  groups %4zu  ARI %6.3f  rooms found %2d/%-2d  pure %2d/%-2d  %6.2f s\n",
-                          l.log.c_str(), observations.size(), p.groups.size(),
-                          sim::adjustedRandIndex(place_of, p.group_of), scores.found, scores.rooms, scores.pure,
+                          d.name.c_str(), d.observations.size(), p.groups.size(),
+                          sim::adjustedRandIndex(d.place_of, p.group_of), scores.found, scores.rooms, scores.pure,
                           scores.rooms, seconds);
     } catch (const std::exception& e) {
       ++errors;
-      std::cout << format("%-40s error: %s\n", l.log.c_str(), e.what());
+      std::cout << format("%-40s error: %s\n", d.name.c_str(), e.what());
     }
   }
   std::cout << format("summary %s: rooms found %d/%d  pure %d/%d%s\n", c.parameters().c_str(), found, rooms, pure,
                       rooms, errors ? format("  %d ERRORS", errors).c_str() : "");
   return errors ? 1 : 0;
 }
-#endif
+
+/// Rooms found and pure over simulated and labelled datasets.
+struct SweepPoint {
+  sim::RoomScores simulated, labelled;
+};
+
+SweepPoint sweepPoint(const std::vector<Dataset>& datasets, const std::vector<LabelledDataset>& logs,
+                      const Configuration& c) {
+  SweepPoint point;
+  const auto add = [](sim::RoomScores& total, const sim::RoomScores& s) {
+    total.rooms += s.rooms;
+    total.found += s.found;
+    total.pure += s.pure;
+    total.whole += s.whole;
+  };
+  for (const Dataset& d : datasets)
+    add(point.simulated, sim::scoreRooms(d.places.of_pose, d.places.is_room, group(d.observations, c).group_of));
+  for (const LabelledDataset& d : logs)
+    add(point.labelled, sim::scoreRooms(d.place_of, d.is_room, group(d.observations, c).group_of));
+  return point;
+}
+
+/// The plateau of the defaults: each parameter of `base` at 75% and 125% of
+/// its value, rooms found and pure on the simulated datasets and on the
+/// labelled logs, and the change of rooms found from the defaults.
+std::string sweepTable(const std::vector<Dataset>& datasets, const std::vector<LabelledDataset>& logs,
+                       const Configuration& base) {
+  struct Parameter {
+    const char* name;
+    std::function<double&(Configuration&)> value;
+  };
+  const std::vector<Parameter> parameters{
+      {"Ncut threshold", [](Configuration& c) -> double& { return c.ncut_threshold; }},
+      {"cell (m)", [](Configuration& c) -> double& { return c.region.cell_size; }},
+      {"range (m)", [](Configuration& c) -> double& { return c.region.max_range; }},
+      {"clearance (m)", [](Configuration& c) -> double& { return c.region.clearance; }},
+  };
+  const SweepPoint reference = sweepPoint(datasets, logs, base);
+  const auto change = [](int value, int of) {
+    return of ? format("%+.1f%%", 100.0 * double(value - of) / double(of)) : std::string("–");
+  };
+  const auto row = [&](const std::string& name, const std::string& value, const SweepPoint& p) {
+    return "| " + name + " | " + value + " | " +
+           format("%d / %d of %d", p.simulated.found, p.simulated.pure, p.simulated.rooms) + " | " +
+           change(p.simulated.found, reference.simulated.found) + " | " +
+           (p.labelled.rooms ? format("%d / %d of %d", p.labelled.found, p.labelled.pure, p.labelled.rooms) +
+                                   " | " + change(p.labelled.found, reference.labelled.found)
+                             : std::string("– | –")) +
+           " |\n";
+  };
+  std::ostringstream out;
+  out << "| parameter | value | simulated: rooms found / pure | change of found | labelled logs: rooms found / pure "
+         "| change of found |\n|---|---|---|---|---|---|\n";
+  out << row("(the defaults)", "–", reference);
+  for (const Parameter& parameter : parameters)
+    for (double factor : {0.75, 1.25}) {
+      Configuration c = base;
+      double& value = parameter.value(c);
+      value *= factor;
+      std::cerr << parameter.name << " " << value << "\n";
+      out << row(parameter.name, format("%g", value), sweepPoint(datasets, logs, c));
+    }
+  return out.str();
+}
 
 /// The page's generated section: the datasets, a summary per configuration
 /// and a table per dataset.
@@ -541,7 +620,9 @@ const char* kUsage =
     "real logs instead of the simulated buildings (each --log with its --labels, in order):\n"
     "  --log LOG --labels LABELS.json\n"
     "the selected laser datasets as CARMEN logs with their labels, for obsgroup partition and --log:\n"
-    "  --write-logs FOLDER\n";
+    "  --write-logs FOLDER\n"
+    "each default at 75% and 125% (rooms found and pure; with --output, the page's 'sweep' section):\n"
+    "  --sweep defaults [--log LOG --labels LABELS.json ...] [selection]\n";
 
 }  // namespace
 
@@ -555,6 +636,7 @@ int main(int argc, char** argv) {
   std::vector<PoseSource> pose_sources{PoseSource::Exact, PoseSource::Drift};
   std::vector<std::string> logs, label_files;
   std::string write_logs;
+  bool sweep = false;
   try {
     RegionParameters& region = configuration.region;
     using Setter = std::function<void(const std::string& flag, const std::string& value)>;
@@ -579,6 +661,11 @@ int main(int argc, char** argv) {
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--threads", integer(configuration.threads)},
         {"--write-logs", [&](const std::string&, const std::string& v) { write_logs = v; }},
+        {"--sweep",
+         [&](const std::string& flag, const std::string& v) {
+           if (v != "defaults") throw std::invalid_argument(flag + " takes 'defaults'");
+           sweep = true;
+         }},
         {"--log", [&](const std::string&, const std::string& v) { logs.push_back(v); }},
         {"--labels", [&](const std::string&, const std::string& v) { label_files.push_back(v); }},
         {"--datasets",
@@ -607,7 +694,7 @@ int main(int argc, char** argv) {
       if (it == options.end() || a + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + flag);
       it->second(flag, argv[++a]);
     }
-    if ((model || split) && !output.empty())
+    if ((model || split) && !output.empty() && !sweep)
       throw std::invalid_argument("--output writes the page; it takes no --model or --split");
     if (buildings.empty() || sensors.empty() || pose_sources.empty()) throw std::invalid_argument("nothing selected");
     if (logs.size() != label_files.size()) throw std::invalid_argument("each --log needs its --labels");
@@ -626,21 +713,38 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-#ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
-  if (!logs.empty()) {
+  std::vector<LabelledDataset> labelled;
+  try {
+    for (std::size_t k = 0; k < logs.size(); ++k) labelled.push_back(readLabelledLog({logs[k], label_files[k]}));
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  if (!labelled.empty() && !sweep) {
     const ObservationGrouping<pcl::PointXYZ> defaults;
     configuration.model = model.value_or(defaults.getSensedSpaceModel());
     configuration.split = split.value_or(defaults.getSplitCriterion());
-    std::vector<LabelledLog> labelled;
-    for (std::size_t k = 0; k < logs.size(); ++k) labelled.push_back({logs[k], label_files[k]});
     return evaluateLabelledLogs(labelled, configuration);
   }
-#endif
 
   const auto start = std::chrono::steady_clock::now();
   const std::vector<Dataset> datasets = makeDatasets(buildings, sensors, pose_sources);
   const double generation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+  if (sweep) {
+    const ObservationGrouping<pcl::PointXYZ> defaults;
+    configuration.model = model.value_or(defaults.getSensedSpaceModel());
+    configuration.split = split.value_or(defaults.getSplitCriterion());
+    const std::string table = "Each default at 75% and 125% of its value, everything else at the defaults; " +
+                              format("%zu simulated datasets, %zu labelled logs.\n\n", datasets.size(),
+                                     labelled.size()) +
+                              sweepTable(datasets, labelled, configuration);
+    if (output.empty()) {
+      std::cout << table;
+      return 0;
+    }
+    return writeGeneratedSection(output, table, "sweep");
+  }
   if (model || split) {
     const ObservationGrouping<pcl::PointXYZ> defaults;
     configuration.model = model.value_or(defaults.getSensedSpaceModel());

@@ -11,17 +11,21 @@
 namespace obsgroup::examples {
 
 /// Replaces the lines between "<!-- generated:begin -->" and
-/// "<!-- generated:end -->" of `file` with `report`, keeping the rest.
+/// "<!-- generated:end -->" of `file` with `report`, keeping the rest; a
+/// page with more than one generated section names them:
+/// "<!-- generated:NAME:begin -->" ... "<!-- generated:NAME:end -->".
 /// Returns 0, or 3 (with a message) when the file has no such section.
-inline int writeGeneratedSection(const std::string& file, const std::string& report) {
+inline int writeGeneratedSection(const std::string& file, const std::string& report, const std::string& name = "") {
   std::ifstream in(file);
   std::stringstream existing;
   existing << in.rdbuf();
   const std::string text = existing.str();
-  const std::string begin = "<!-- generated:begin -->\n", end = "<!-- generated:end -->";
+  const std::string tag = name.empty() ? "generated:" : "generated:" + name + ":";
+  const std::string begin = "<!-- " + tag + "begin -->\n", end = "<!-- " + tag + "end -->";
   const std::size_t b = text.find(begin), e = text.find(end);
   if (b == std::string::npos || e == std::string::npos || e < b) {
-    std::cerr << "error: " << file << ": no '<!-- generated:begin -->' ... '<!-- generated:end -->' section\n";
+    std::cerr << "error: " << file << ": no '" << begin.substr(0, begin.size() - 1) << "' ... '" << end
+              << "' section\n";
     return 3;
   }
   std::ofstream(file) << text.substr(0, b + begin.size()) << report << text.substr(e);
