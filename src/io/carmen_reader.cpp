@@ -249,15 +249,10 @@ bool startsWithMessage(std::string_view line, std::string_view name) {
 
 LogLines splitLines(std::string_view content) {
   LogLines log;
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string::npos) end = content.size();
-    const std::string_view line(content.data() + start, end - start);
-    log.lines.emplace_back(++number, line);
+  for (TextLines lines(content); lines.next();) {
+    log.lines.emplace_back(lines.number(), lines.line());
     for (LaserSource s : {LaserSource::Front, LaserSource::Rear, LaserSource::RobotLaser})
-      if (startsWithMessage(line, messageName(s))) ++log.counts[s];
-    start = end + 1;
+      if (startsWithMessage(lines.line(), messageName(s))) ++log.counts[s];
   }
   return log;
 }

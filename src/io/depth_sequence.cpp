@@ -184,15 +184,7 @@ std::vector<Eigen::Isometry3d> parseTrajectoryLog(std::string_view content, cons
   content = withoutByteOrderMark(content);
   // The non-empty lines with their numbers.
   std::vector<std::pair<std::size_t, std::vector<std::string_view>>> lines;
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string_view::npos) end = content.size();
-    auto fields = splitFields(content.substr(start, end - start));
-    start = end + 1;
-    ++number;
-    if (!fields.empty() && fields[0].front() != '#') lines.emplace_back(number, std::move(fields));
-  }
+  for (TextLines text(content); text.nextData();) lines.emplace_back(text.number(), text.fields());
   std::vector<Eigen::Isometry3d> poses;
   for (std::size_t k = 0; k < lines.size(); k += 5) {
     const std::size_t frame = k / 5;
@@ -247,14 +239,9 @@ std::vector<DepthFrame> readDepthList(const fs::path& folder) {
   const std::string bytes = readInputBytes(list, "depth list");
   const std::string_view content = withoutByteOrderMark(bytes);
   std::vector<DepthFrame> frames;
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string_view::npos) end = content.size();
-    const auto fields = splitFields(content.substr(start, end - start));
-    start = end + 1;
-    ++number;
-    if (fields.empty() || fields[0].front() == '#') continue;
+  for (TextLines lines(content); lines.nextData();) {
+    const auto& fields = lines.fields();
+    const std::size_t number = lines.number();
     if (fields.size() != 2)
       throw inputError(list, number,
                        "a line has " + std::to_string(fields.size()) + " values, expected 2 (timestamp filename)");

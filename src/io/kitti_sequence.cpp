@@ -43,14 +43,10 @@ pcl::PointCloud<pcl::PointXYZI>::Ptr decodeKittiScan(std::string_view bytes, con
 
 Eigen::Isometry3d parseKittiCalibration(std::string_view content, const std::string& path) {
   content = withoutByteOrderMark(content);
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string_view::npos) end = content.size();
-    const auto fields = splitFields(content.substr(start, end - start));
-    start = end + 1;
-    ++number;
-    if (fields.empty() || (fields[0] != "Tr:" && fields[0] != "Tr_velo_to_cam:")) continue;
+  for (TextLines lines(content); lines.nextData();) {
+    const auto& fields = lines.fields();
+    const std::size_t number = lines.number();
+    if (fields[0] != "Tr:" && fields[0] != "Tr_velo_to_cam:") continue;
     if (fields.size() != 13)
       throw inputError(path, number,
                        "field 'Tr': " + std::to_string(fields.size() - 1) + " values, expected 12 (a 3x4 [R|t])");

@@ -71,15 +71,10 @@ void forEachPoseLine(std::string_view content, const std::string& path, PoseForm
   const std::size_t expected = format == PoseFormat::Tum ? 8 : 12;
   const std::string layout = format == PoseFormat::Tum ? "TUM: timestamp tx ty tz qx qy qz qw"
                                                        : "KITTI: 12 values of a 3x4 [R|t] matrix";
-  std::size_t number = 0, count = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string_view::npos) end = content.size();
-    const std::string_view line = content.substr(start, end - start);
-    start = end + 1;
-    ++number;
-    const auto fields = splitFields(line);
-    if (fields.empty() || fields[0].front() == '#') continue;
+  std::size_t count = 0;
+  for (TextLines lines(content); lines.nextData();) {
+    const auto& fields = lines.fields();
+    const std::size_t number = lines.number();
     const LineRef where{path, number};
     if (fields.size() != expected)
       throw inputError(path, number,
@@ -120,14 +115,9 @@ std::vector<StampedPose> parseStampedPoses(std::string_view content, const std::
 PoseFormat detectPoseFormat(std::string_view content, const std::string& path) {
   if (isGzip(content)) return detectPoseFormat(gunzip(content, path), path);
   content = withoutByteOrderMark(content);
-  std::size_t number = 0;
-  for (std::size_t start = 0; start < content.size();) {
-    std::size_t end = content.find('\n', start);
-    if (end == std::string_view::npos) end = content.size();
-    const auto fields = splitFields(content.substr(start, end - start));
-    start = end + 1;
-    ++number;
-    if (fields.empty() || fields[0].front() == '#') continue;
+  for (TextLines lines(content); lines.nextData();) {
+    const auto& fields = lines.fields();
+    const std::size_t number = lines.number();
     if (fields.size() == 8) return PoseFormat::Tum;
     if (fields.size() == 12) return PoseFormat::Kitti;
     throw inputError(path, number,

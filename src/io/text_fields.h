@@ -26,6 +26,42 @@ inline std::vector<std::string_view> splitFields(std::string_view line) {
   return fields;
 }
 
+/// The lines of a text, one at a time, numbered from 1 (the readers of logs,
+/// pose files, lists and calibrations all walk their text this way):
+///   for (TextLines lines(content); lines.next();) use(lines.line(), lines.number());
+class TextLines {
+ public:
+  explicit TextLines(std::string_view content) : content_(content) {}
+  /// Moves to the next line (without its '\n'); false after the last.
+  bool next() {
+    if (start_ >= content_.size()) return false;
+    std::size_t end = content_.find('\n', start_);
+    if (end == std::string_view::npos) end = content_.size();
+    line_ = content_.substr(start_, end - start_);
+    start_ = end + 1;
+    ++number_;
+    return true;
+  }
+  /// Moves to the next line holding data: not blank, not a '#' comment; its
+  /// fields are in fields(). False after the last.
+  bool nextData() {
+    while (next()) {
+      fields_ = splitFields(line_);
+      if (!fields_.empty() && fields_[0].front() != '#') return true;
+    }
+    return false;
+  }
+  std::string_view line() const { return line_; }
+  std::size_t number() const { return number_; }
+  /// The fields of the line nextData() moved to.
+  const std::vector<std::string_view>& fields() const { return fields_; }
+
+ private:
+  std::string_view content_, line_;
+  std::size_t start_ = 0, number_ = 0;
+  std::vector<std::string_view> fields_;
+};
+
 /// A line of a text file, for error messages.
 struct LineRef {
   const std::string& file;
