@@ -339,3 +339,22 @@ TEST(TopologicalMap, BadFramesAreRefusedByName) {
                 .find("reference 3 is not a member"),
             std::string::npos);
 }
+
+TEST(TopologicalMap, GlobalPosesPlaceEachMemberByItsMap) {
+  const WeightMatrix W = chain(4);
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 4; ++i) poses.push_back(pose2D(i, 0.5 * i, 0.1 * i));
+  Partition partition;
+  partition.groups = {{0, 1}, {2, 3}};
+  TopologicalMap topology = buildTopologicalMap(initialFrames(partition, W, poses), W, poses);
+  // Unrefined maps give back the input poses...
+  std::vector<Eigen::Isometry3d> global = globalPoses(topology, 4);
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(global[i].isApprox(poses[i], 1e-12)) << i;
+  // ...and a member moved in its map's frame moves in the world by the same.
+  const int other = topology.nodes[1].members[0] == topology.nodes[1].reference ? 1 : 0;
+  topology.nodes[1].member_poses[other] = topology.nodes[1].member_poses[other] * pose2D(0.2, 0, 0);
+  global = globalPoses(topology, 4);
+  const int moved = topology.nodes[1].members[other];
+  EXPECT_TRUE(global[moved].isApprox(poses[moved] * pose2D(0.2, 0, 0), 1e-12));
+  EXPECT_THROW(globalPoses(topology, 3), std::invalid_argument);
+}

@@ -1,7 +1,6 @@
 // The pictures' drawn content, read back with cairo: arcs between group
 // centres, the legend, distinct colours of neighbouring groups, a crop that a
 // far return does not shrink, the local maps' scale bar.
-#include "output_folder.h"
 #include "pictures.h"
 
 #include <cairo.h>
@@ -18,8 +17,8 @@
 
 namespace fs = std::filesystem;
 using namespace obsgroup;
-using io::MapLayout;
-using io::mapLayout;
+using render::MapLayout;
+using render::mapLayout;
 
 namespace {
 
@@ -107,9 +106,8 @@ class Pictures : public ::testing::Test {
 
   fs::path writeMap(const Scene& scene) {
     const fs::path out = dir_ / ("out" + std::to_string(runs_++));
-    io::OutputFolder folder(out.string(), false);
-    io::writeMapPictures(folder, scene.world, scene.poses, scene.poses, scene.partition, scene.topology);
-    folder.commit();
+    render::writeMapPictures(render::folderWriter(out.string()), scene.world, scene.poses, scene.poses,
+                             scene.partition, scene.topology);
     return out / "map.png";
   }
 
@@ -236,7 +234,7 @@ TopologicalMap randomTopology(int n, int arcs, bool random) {
 
 TEST(GroupColours, NoArcJoinsTwoGroupsOfOneColour) {
   const TopologicalMap topology = randomTopology(300, 900, false);
-  const std::vector<int> colours = io::groupColours(topology);
+  const std::vector<int> colours = render::groupColours(topology);
   ASSERT_EQ(colours.size(), 300u);
   for (const TopologicalArc& arc : topology.arcs) EXPECT_NE(colours[arc.from], colours[arc.to]);
   EXPECT_LT(*std::max_element(colours.begin(), colours.end()), 12);
@@ -244,9 +242,9 @@ TEST(GroupColours, NoArcJoinsTwoGroupsOfOneColour) {
 
 TEST(GroupColours, ADenseTopologyKeepsTheShownArcsApart) {
   const TopologicalMap topology = randomTopology(300, 6000, true);  // 40 arcs a node
-  const std::vector<int> colours = io::groupColours(topology);
+  const std::vector<int> colours = render::groupColours(topology);
   ASSERT_EQ(colours.size(), 300u);
-  for (std::size_t a : io::shownArcs(topology, 3))
+  for (std::size_t a : render::shownArcs(topology, 3))
     EXPECT_NE(colours[topology.arcs[a].from], colours[topology.arcs[a].to]);
   EXPECT_LT(*std::max_element(colours.begin(), colours.end()), 12);  // all well separated
 }
@@ -260,11 +258,11 @@ TEST(ShownArcs, EachNodeKeepsItsStrongest) {
       arc.from = a, arc.to = b, arc.weight = a * 10 + b;
       topology.arcs.push_back(arc);
     }
-  const std::vector<std::size_t> shown = io::shownArcs(topology, 1);
+  const std::vector<std::size_t> shown = render::shownArcs(topology, 1);
   // Node 5's strongest is (4, 5) for 4 and 5; (3, 5) for 3, (2, 5), (1, 5), (0, 5).
   ASSERT_EQ(shown.size(), 5u);
   for (std::size_t a : shown) EXPECT_EQ(topology.arcs[a].to, 5);
-  EXPECT_EQ(io::shownArcs(topology, 5).size(), topology.arcs.size());
+  EXPECT_EQ(render::shownArcs(topology, 5).size(), topology.arcs.size());
 }
 
 TEST_F(Pictures, AThousandGroupsKeepTheirMarksApart) {
@@ -327,11 +325,7 @@ TEST_F(Pictures, LocalMapsHaveAScaleBar) {
   for (int i : scene.partition.groups[0])
     for (auto p = scene.world.begin(i); p != scene.world.end(i); ++p) maps[0].cloud->push_back({p->x() + 2, p->y(), 0});
   const fs::path out = dir_ / "local";
-  {
-    io::OutputFolder folder(out.string(), false);
-    io::writeLocalMapPictures(folder, maps, 1);
-    folder.commit();
-  }
+  render::writeLocalMapPictures(render::folderWriter(out.string()), maps, 1);
   const Png png(out / "local_maps" / "group_000.png");
   ASSERT_TRUE(png.ok());
   // The bar: a black line in the top margin, ending 40 px from the right.

@@ -13,7 +13,6 @@
 #include "progress_bar.h"
 #include "result_writers.h"
 #include "stream_grouping.h"
-#include "text_fields.h"
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/maps/topological_map.h>
@@ -23,6 +22,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -226,11 +226,17 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   ObservationRegions regions;
   const bool tinted = args.sso != SensedSpaceModel::Points;
   if (tinted) regions = grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, world);
-  io::writeMapPictures(out, world, posesOf(observations), io::refinedPoses(maps.topology, observations.size()),
-                       partition, maps.topology, tinted ? &regions : nullptr);
-  io::writeWeightsPicture(out, grouped.W, partition);
-  io::writeFiedlerPicture(out, partition);
-  io::writeLocalMapPictures(out, maps.maps, args.threads, io::groupColours(maps.topology));
+  // Staged with the other results, so that they appear together or not at all.
+  const render::PictureWriter staged = [&out](const std::string& name,
+                                              const std::function<void(const std::string&)>& write) {
+    out.write(name, write);
+  };
+  render::writeMapPictures(staged, world, posesOf(observations),
+                           globalPoses(maps.topology, observations.size()), partition, maps.topology,
+                           tinted ? &regions : nullptr);
+  render::writeWeightsPicture(staged, grouped.W, partition);
+  render::writeFiedlerPicture(staged, partition);
+  render::writeLocalMapPictures(staged, maps.maps, args.threads, render::groupColours(maps.topology));
 }
 
 /// The method's settings as partition.json records them.
@@ -411,8 +417,9 @@ int runCarmen(const PartitionArgs& args) {
 std::optional<double> stampOfName(const std::string& file) {
   const std::string stem = std::filesystem::path(file).stem().string();
   if (stem.find('.') == std::string::npos) return std::nullopt;  // 000012.pcd is an index, not a time
-  const auto value = io::toDouble(stem);
-  if (!value || !std::isfinite(*value)) return std::nullopt;
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(stem.data(), stem.data() + stem.size(), value);
+  if (error != std::errc() || end != stem.data() + stem.size() || !std::isfinite(value)) return std::nullopt;
   return value;
 }
 

@@ -132,6 +132,24 @@ TopologicalArc makeArc(int from, const std::vector<CrossPair>& pairs, std::size_
 
 }  // namespace
 
+std::vector<Eigen::Isometry3d> globalPoses(const TopologicalMap& topology, std::size_t observations) {
+  std::vector<Eigen::Isometry3d> poses(observations, Eigen::Isometry3d::Identity());
+  for (std::size_t g = 0; g < topology.nodes.size(); ++g) {
+    const LocalMapFrame& node = topology.nodes[g];
+    if (node.member_poses.size() != node.members.size())
+      throw std::invalid_argument("globalPoses: local map " + std::to_string(g) + " has " +
+                                  std::to_string(node.member_poses.size()) + " member poses for " +
+                                  std::to_string(node.members.size()) + " members");
+    for (std::size_t k = 0; k < node.members.size(); ++k) {
+      if (node.members[k] < 0 || std::size_t(node.members[k]) >= observations)
+        throw std::invalid_argument("globalPoses: local map " + std::to_string(g) + " holds observation " +
+                                    std::to_string(node.members[k]) + " of " + std::to_string(observations));
+      poses[node.members[k]] = node.pose * node.member_poses[k];
+    }
+  }
+  return poses;
+}
+
 TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
                                    const std::vector<Eigen::Isometry3d>& poses, int threads) {
   const int n = static_cast<int>(poses.size());

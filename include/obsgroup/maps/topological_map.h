@@ -71,6 +71,12 @@ inline constexpr double kSequencePairWeight = 1e-3;
 TopologicalMap buildTopologicalMap(std::vector<LocalMapFrame> nodes, const WeightMatrix& W,
                                    const std::vector<Eigen::Isometry3d>& poses, int threads = 0);
 
+/// The global pose of every observation as its local map places it: member
+/// k of node g at nodes[g].pose * nodes[g].member_poses[k] (the reference's
+/// input pose times the member's, possibly refined, pose in the reference
+/// frame). Throws std::invalid_argument for a member not below `observations`.
+std::vector<Eigen::Isometry3d> globalPoses(const TopologicalMap& topology, std::size_t observations);
+
 /// The frames of all groups of a partition from the input poses.
 std::vector<LocalMapFrame> initialFrames(const Partition& partition, const WeightMatrix& W,
                                          const std::vector<Eigen::Isometry3d>& poses);

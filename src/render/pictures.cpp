@@ -13,13 +13,14 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
 #include <string>
 #include <tuple>
 
-namespace obsgroup::io {
+namespace obsgroup::render {
 
 namespace {
 
@@ -27,8 +28,7 @@ struct Rgb {
   double r, g, b;
 };
 
-constexpr int kDistinctColours = 12;  ///< well separated colours of the palette
-constexpr int kArcsPerGroup = 3;      ///< map.png shows each group's strongest arcs
+constexpr int kArcsPerGroup = 3;  ///< map.png shows each group's strongest arcs
 
 /// Colour `index` of the palette: 12 well separated colours (no grey, which
 /// the arcs use), then golden-angle hues.
@@ -55,8 +55,8 @@ Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
 }
 
-void writePng(const OutputFolder& out, const std::string& name, cairo_surface_t* surface) {
-  out.write(name, [surface](const std::string& temporary) {
+void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t* surface) {
+  out(name, [surface](const std::string& temporary) {
     if (cairo_surface_write_to_png(surface, temporary.c_str()) != CAIRO_STATUS_SUCCESS)
       throw std::runtime_error(temporary + ": cairo cannot write the PNG");
   });
@@ -565,7 +565,7 @@ void drawMemberPoses(cairo_t* cr, const View& v, const LocalMapFrame& frame, con
 
 /// local_maps/group_NNN.png of one local map, whose points (in its frame)
 /// are given without the non-finite ones.
-void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFrame& frame,
+void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFrame& frame,
                           const std::vector<Eigen::Vector3f>& points, const Rgb& colour) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
   for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
@@ -590,106 +590,10 @@ void writeLocalMapPicture(const OutputFolder& out, int group, const LocalMapFram
   writePng(out, name, surface.get());
 }
 
-/// Neighbours of each node, ascending: joined by one of `arcs` (indices into
-/// topology.arcs), or among each other's two nearest centres (the mean of
-/// the members' global poses).
-std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology, const std::vector<std::size_t>& arcs) {
-  const int n = static_cast<int>(topology.nodes.size());
-  std::vector<std::vector<int>> neighbours(n);
-  for (std::size_t a : arcs) {
-    const TopologicalArc& arc = topology.arcs[a];
-    if (arc.from >= 0 && arc.to < n) neighbours[arc.from].push_back(arc.to), neighbours[arc.to].push_back(arc.from);
-  }
-  std::vector<Eigen::Vector3d> centre(n, Eigen::Vector3d::Zero());
-  for (int g = 0; g < n; ++g) {
-    const LocalMapFrame& node = topology.nodes[g];
-    for (const auto& member : node.member_poses) centre[g] += (node.pose * member).translation();
-    centre[g] /= double(std::max<std::size_t>(1, node.member_poses.size()));
-  }
-  for (int g = 0; g < n; ++g) {
-    std::vector<std::pair<double, int>> by_distance;
-    for (int h = 0; h < n; ++h)
-      if (h != g) by_distance.emplace_back((centre[g] - centre[h]).squaredNorm(), h);
-    const std::size_t k = std::min<std::size_t>(2, by_distance.size());
-    std::partial_sort(by_distance.begin(), by_distance.begin() + k, by_distance.end());
-    for (std::size_t j = 0; j < k; ++j)
-      neighbours[g].push_back(by_distance[j].second), neighbours[by_distance[j].second].push_back(g);
-  }
-  for (auto& list : neighbours) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
-  return neighbours;
-}
-
-/// A greedy colouring (DSATUR: next the node whose neighbours hold the most
-/// distinct colours, then the most neighbours, then the lowest index; the
-/// smallest colour none of them holds).
-std::vector<int> colourGraph(const std::vector<std::vector<int>>& neighbours) {
-  const int n = static_cast<int>(neighbours.size());
-  std::vector<int> colour(n, -1);
-  std::vector<std::vector<char>> seen(n);  // colours held by each node's neighbours
-  std::vector<int> saturation(n, 0);
-  for (int step = 0; step < n; ++step) {
-    int next = -1;
-    for (int g = 0; g < n; ++g)
-      if (colour[g] < 0 && (next < 0 || std::make_pair(saturation[g], neighbours[g].size()) >
-                                            std::make_pair(saturation[next], neighbours[next].size())))
-        next = g;
-    const auto free = std::find(seen[next].begin(), seen[next].end(), 0);
-    colour[next] = int(free - seen[next].begin());
-    for (int h : neighbours[next]) {
-      if (seen[h].size() <= std::size_t(colour[next])) seen[h].resize(colour[next] + 1, 0);
-      if (!seen[h][colour[next]]) seen[h][colour[next]] = 1, ++saturation[h];
-    }
-  }
-  return colour;
-}
-
 }  // namespace
 
-std::vector<int> groupColours(const TopologicalMap& topology) {
-  std::vector<std::size_t> all(topology.arcs.size());
-  std::iota(all.begin(), all.end(), std::size_t(0));
-  std::vector<int> colours = colourGraph(groupNeighbours(topology, all));
-  if (!colours.empty() && *std::max_element(colours.begin(), colours.end()) >= kDistinctColours)
-    colours = colourGraph(groupNeighbours(topology, shownArcs(topology, kArcsPerGroup)));
-  return colours;
-}
-
-std::vector<std::size_t> shownArcs(const TopologicalMap& topology, int per_node) {
-  const auto stronger = [&](std::size_t a, std::size_t b) {
-    const TopologicalArc &x = topology.arcs[a], &y = topology.arcs[b];
-    return std::tie(x.weight, x.overlapping_pairs, x.sequence_pairs) >
-           std::tie(y.weight, y.overlapping_pairs, y.sequence_pairs);
-  };
-  std::vector<std::vector<std::size_t>> of(topology.nodes.size());
-  for (std::size_t a = 0; a < topology.arcs.size(); ++a) {
-    const TopologicalArc& arc = topology.arcs[a];
-    for (int node : {arc.from, arc.to})
-      if (node >= 0 && std::size_t(node) < of.size()) of[node].push_back(a);
-  }
-  std::vector<char> shown(topology.arcs.size(), 0);
-  for (auto& arcs : of) {
-    const std::size_t k = std::min<std::size_t>(std::max(0, per_node), arcs.size());
-    std::partial_sort(arcs.begin(), arcs.begin() + k, arcs.end(), stronger);
-    for (std::size_t j = 0; j < k; ++j) shown[arcs[j]] = 1;
-  }
-  std::vector<std::size_t> result;
-  for (std::size_t a = 0; a < shown.size(); ++a)
-    if (shown[a]) result.push_back(a);
-  return result;
-}
-
-std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std::size_t observations) {
-  std::vector<Eigen::Isometry3d> poses(observations, Eigen::Isometry3d::Identity());
-  for (const LocalMapFrame& node : topology.nodes)
-    for (std::size_t k = 0; k < node.members.size(); ++k) poses.at(node.members[k]) = node.pose * node.member_poses[k];
-  return poses;
-}
-
 template <typename PointT>
-void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads,
+void writeLocalMapPictures(const PictureWriter& out, const std::vector<LocalMap<PointT>>& maps, int threads,
                            const std::vector<int>& colours) {
   parallelFor(maps.size(), threads, [&](std::size_t g) {
     std::vector<Eigen::Vector3f> points;
@@ -700,11 +604,11 @@ void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<P
   });
 }
 
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int,
+template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZ>>&, int,
                                     const std::vector<int>&);
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&, int,
+template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZI>>&, int,
                                     const std::vector<int>&);
-template void writeLocalMapPictures(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int,
+template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int,
                                     const std::vector<int>&);
 
 MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
@@ -716,7 +620,7 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
   return layoutOf(atDrawnPoses(world, poses, drawn), positions, partition, topology);
 }
 
-void writeMapPictures(const OutputFolder& out, const WorldPoints& input_world,
+void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
                       const std::vector<Eigen::Isometry3d>& poses, const std::vector<Eigen::Isometry3d>& drawn,
                       const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
   const WorldPoints world = atDrawnPoses(input_world, poses, drawn);
@@ -733,7 +637,7 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& input_world,
   Surface png = imageSurface(layout.view.width, layout.view.height);
   draw(png.get());
   writePng(out, "map.png", png.get());
-  out.write("map.svg", [&](const std::string& temporary) {
+  out("map.svg", [&](const std::string& temporary) {
     Surface svg(cairo_svg_surface_create(temporary.c_str(), layout.view.width, layout.view.height),
                 cairo_surface_destroy);
     draw(svg.get());
@@ -800,7 +704,7 @@ void drawFiedlerPlot(cairo_t* cr, const SplitNode& node, int index, double ox, d
 
 }  // namespace
 
-void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const Partition& partition) {
+void writeWeightsPicture(const PictureWriter& out, const WeightMatrix& W, const Partition& partition) {
   const int n = static_cast<int>(W.rows());
   if (n == 0) return;
   // Position of each observation once ordered by group.
@@ -846,7 +750,7 @@ void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const P
   writePng(out, "weights.png", surface.get());
 }
 
-void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
+void writeFiedlerPicture(const PictureWriter& out, const Partition& partition) {
   std::vector<const SplitNode*> shown;
   for (const SplitNode& node : partition.splits)
     if (node.attempted && node.eigenvector.size() > 0 && shown.size() < 4) shown.push_back(&node);
@@ -866,4 +770,12 @@ void writeFiedlerPicture(const OutputFolder& out, const Partition& partition) {
   writePng(out, "fiedler.png", surface.get());
 }
 
-}  // namespace obsgroup::io
+PictureWriter folderWriter(const std::string& folder) {
+  return [folder](const std::string& name, const std::function<void(const std::string& path)>& write) {
+    const std::filesystem::path path = std::filesystem::path(folder) / name;
+    std::filesystem::create_directories(path.parent_path());
+    write(path.string());
+  };
+}
+
+}  // namespace obsgroup::render

@@ -1,9 +1,10 @@
 #pragma once
 // Pictures of a partition, drawn with cairo: the map from above coloured by
 // group (like the paper's Fig. 5), each local map from above, W ordered by
-// group (Fig. 3f) and the eigenvectors of the first splits (Fig. 2).
+// group (Fig. 3f) and the eigenvectors of the first splits (Fig. 2). The
+// drawing alone: where a picture is written is the caller's (PictureWriter).
 
-#include "output_folder.h"
+#include "group_colours.h"
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/maps/topological_map.h>
@@ -11,14 +12,20 @@
 #include <obsgroup/overlap/world_points.h>
 #include <obsgroup/partition/recursive_partitioner.h>
 
+#include <functional>
+#include <string>
 #include <vector>
 
-namespace obsgroup::io {
+namespace obsgroup::render {
 
-/// The global pose of every observation after refinement: member k of node
-/// g is at nodes[g].pose * nodes[g].member_poses[k] (the reference's input
-/// pose times the member's refined pose in the reference frame).
-std::vector<Eigen::Isometry3d> refinedPoses(const TopologicalMap& topology, std::size_t observations);
+/// Where a picture goes: called with its name among the results ("map.png",
+/// "local_maps/group_003.png") and a function that writes it to a path. The
+/// command stages its results in its output folder; folderWriter() writes
+/// straight into a folder.
+using PictureWriter =
+    std::function<void(const std::string& name, const std::function<void(const std::string& path)>& write)>;
+/// Writes each picture to `folder`/name, creating the folders it needs.
+PictureWriter folderWriter(const std::string& folder);
 
 /// World (re-centred) metres to picture pixels, y up.
 struct PictureView {
@@ -27,20 +34,6 @@ struct PictureView {
   double px(double x) const { return margin + (x - min_x) * scale; }
   double py(double y) const { return margin + (max_y - y) * scale; }
 };
-
-/// Palette index of each group in the pictures (map.png and the local maps):
-/// a greedy (DSATUR) colouring of the groups joined by an arc of the topology
-/// or among each other's two nearest group centres, so that such neighbours
-/// never share a colour. When that needs more than the palette's 12 well
-/// separated colours (a dense topology: a real log's 163 groups with 5,087
-/// arcs need 44; the 382 arcs shown, 5), only the arcs map.png shows
-/// (shownArcs()) and the nearest centres count.
-std::vector<int> groupColours(const TopologicalMap& topology);
-
-/// The arcs map.png draws, indices into topology.arcs, ascending: each node's
-/// `per_node` strongest (by weight, then overlapping and sequence pairs).
-/// topology.json keeps all of them.
-std::vector<std::size_t> shownArcs(const TopologicalMap& topology, int per_node = 3);
 
 /// Where map.png puts things.
 struct MapLayout {
@@ -73,10 +66,10 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 /// picture, which grows with their number. With regions, each cell is first
 /// tinted with the colour of the group most of whose observations hold it.
 /// `world` holds the points at the input `poses` (the frame of `world` before
-/// re-centring); each observation is drawn at `drawn[i]` (refinedPoses()),
+/// re-centring); each observation is drawn at `drawn[i]` (globalPoses()),
 /// its points moved by drawn[i] * poses[i]^-1. The regions are drawn where
 /// they were computed, at the input poses.
-void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
+void writeMapPictures(const PictureWriter& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
                       const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
                       const TopologicalMap& topology, const ObservationRegions* regions = nullptr);
 
@@ -89,15 +82,15 @@ void writeMapPictures(const OutputFolder& out, const WorldPoints& world, const s
 /// (groupColours(), as in map.png; empty: g). Written on `threads` threads
 /// (<= 0: all); each picture is the same for any number.
 template <typename PointT>
-void writeLocalMapPictures(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0,
+void writeLocalMapPictures(const PictureWriter& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0,
                            const std::vector<int>& colours = {});
 
 /// weights.png: W as an image, rows and columns ordered by group, darker for
 /// a larger overlap, each group boxed.
-void writeWeightsPicture(const OutputFolder& out, const WeightMatrix& W, const Partition& partition);
+void writeWeightsPicture(const PictureWriter& out, const WeightMatrix& W, const Partition& partition);
 
 /// fiedler.png: the eigenvector components of the first (up to four)
 /// bisections, in observation order, with the split threshold drawn.
-void writeFiedlerPicture(const OutputFolder& out, const Partition& partition);
+void writeFiedlerPicture(const PictureWriter& out, const Partition& partition);
 
-}  // namespace obsgroup::io
+}  // namespace obsgroup::render
