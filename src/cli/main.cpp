@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -102,8 +103,8 @@ void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->option_text(choices(io::kPoseFormatNames))
       ->group("PCD sequences");
   command.add_option("--max-time-difference", args.max_time_difference,
-                     "TUM poses matched by timestamp (depth images, PCD, bags): most seconds between a frame and its pose (default: "
-                     "0.02)")
+                     "TUM poses matched by timestamp (depth images, PCD, bags): most seconds between a frame and its pose (default: " +
+                         (std::ostringstream() << io::kDefaultMaxTimeDifference).str() + ")")
       ->check(finiteNumber(0.0))
       ->group("PCD sequences");
 }

@@ -439,16 +439,14 @@ int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointK
                          std::all_of(stamps.begin(), stamps.end(), [](const auto& t) { return t.has_value(); });
     if (stamped) {  // match each cloud to the pose nearest its stamp
       matched = "timestamp";
-      const double tolerance = args.max_time_difference.value_or(0.02);
-      std::vector<io::StampedPose> stamped_poses = io::parseStampedPoses(bytes, name);
-      std::stable_sort(stamped_poses.begin(), stamped_poses.end(),
-                       [](const io::StampedPose& a, const io::StampedPose& b) { return a.stamp < b.stamp; });
+      const double tolerance = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
+      const io::StampedPoseIndex stamped_poses(io::parseStampedPoses(bytes, name), tolerance);
       std::vector<std::string> kept;
       poses.emplace();
       for (std::size_t k = 0; k < files.size(); ++k)
-        if (const auto match = io::nearestStamp(stamped_poses, *stamps[k], tolerance)) {
+        if (const auto pose = stamped_poses.at(*stamps[k])) {
           kept.push_back(files[k]);
-          poses->push_back(stamped_poses[*match].pose);
+          poses->push_back(*pose);
         }
       if (kept.empty())
         throw io::InputError(name + ": no pose within " + std::to_string(tolerance) + " s of any of the " +
@@ -486,7 +484,7 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
   options.depth_scale = args.depth_scale;
   options.max_depth = args.depth_max;
   options.stride = args.stride.value_or(1);
-  options.max_time_difference = args.max_time_difference.value_or(0.02);
+  options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
   options.poses = args.poses;
   options.up = args.up;
   io::DepthSequence sequence = io::loadDepthSequence(args.input, layout, options);
@@ -539,7 +537,7 @@ int runBagAs(const PartitionArgs& args, const io::BagReader& reader, io::PointKi
                       {"point_type", io::toString(kind)}};
   if (args.poses) {
     input.parameters["poses"] = *args.poses;
-    input.parameters["max_time_difference"] = args.max_time_difference.value_or(0.02);
+    input.parameters["max_time_difference"] = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
   }
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
@@ -558,7 +556,7 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   options.pose_topic = args.pose_topic;
   options.fixed_frame = args.fixed_frame;
   options.poses_file = args.poses;
-  options.max_time_difference = args.max_time_difference.value_or(0.02);
+  options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
   const io::BagReader reader(args.input, version, options);
   switch (const io::PointKind kind = reader.pointKind()) {
     case io::PointKind::XYZI: return runBagAs<pcl::PointXYZI>(args, reader, kind, start);

@@ -360,10 +360,8 @@ class PoseSource {
       : tree_(messages, bag_name), bag_name_(bag_name), warnings_(warnings) {
     if (options.poses_file) {
       const std::string name = inputName(*options.poses_file);
-      stamped_ = parseStampedPoses(readInputBytes(*options.poses_file, "poses file"), name);
-      std::stable_sort(stamped_.begin(), stamped_.end(),
-                       [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
-      tolerance_ = options.max_time_difference;
+      stamped_.emplace(parseStampedPoses(readInputBytes(*options.poses_file, "poses file"), name),
+                       options.max_time_difference);
       description_ = name;
       fixed_frame_ = "";  // whatever frame the file's poses are in
       return;
@@ -403,11 +401,7 @@ class PoseSource {
 
   /// The sensor's pose at the stamp, or nothing when the poses do not span it.
   std::optional<Eigen::Isometry3d> at(const std::string& sensor, double stamp, const std::string& context) {
-    if (tolerance_) {
-      const auto match = nearestStamp(stamped_, stamp, *tolerance_);
-      if (!match) return std::nullopt;
-      return stamped_[*match].pose;
-    }
+    if (stamped_) return stamped_->at(stamp);
     if (description_ == "/tf") {
       if (!tree_.connected(fixed_frame_, sensor))
         throw InputError(context + ": /tf does not connect the sensor's frame '" + sensor + "' to '" + fixed_frame_ + "'");
@@ -440,8 +434,7 @@ class PoseSource {
 
   FrameTree tree_;
   PoseTrack track_;
-  std::vector<StampedPose> stamped_;      // poses file
-  std::optional<double> tolerance_;       // set for a poses file
+  std::optional<StampedPoseIndex> stamped_;  // a poses file's
   std::string body_;
   std::string fixed_frame_;
   std::string description_;

@@ -301,19 +301,17 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
   if (layout == DepthLayout::TumRgbd) {
     const std::vector<DepthFrame> frames = readDepthList(dir);
     const std::string truth = options.poses.value_or((dir / "groundtruth.txt").string());
-    std::vector<StampedPose> poses = readStampedPoses(truth);
-    std::stable_sort(poses.begin(), poses.end(),
-                     [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+    const StampedPoseIndex poses(readStampedPoses(truth), options.max_time_difference);
     std::vector<std::string> files;
     std::vector<Eigen::Isometry3d> matched;
     for (const DepthFrame& frame : frames) {
-      const auto match = nearestStamp(poses, frame.stamp, options.max_time_difference);
-      if (!match) {
+      const auto pose = poses.at(frame.stamp);
+      if (!pose) {
         ++out.skipped;
         continue;
       }
       files.push_back(frame.file);
-      matched.push_back(poses[*match].pose);
+      matched.push_back(*pose);
     }
     const UpAxis up = options.up.value_or(UpAxis::PlusZ);
     putUpOnZ(matched, up == UpAxis::Auto ? camerasUpAxis(matched) : up, options.up.has_value(), truth, out);

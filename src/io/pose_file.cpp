@@ -145,4 +145,16 @@ std::optional<std::size_t> nearestStamp(const std::vector<StampedPose>& poses, d
   return best;
 }
 
+StampedPoseIndex::StampedPoseIndex(std::vector<StampedPose> poses, double tolerance)
+    : poses_(std::move(poses)), tolerance_(tolerance) {
+  std::stable_sort(poses_.begin(), poses_.end(),
+                   [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+}
+
+std::optional<Eigen::Isometry3d> StampedPoseIndex::at(double stamp) const {
+  const auto match = nearestStamp(poses_, stamp, tolerance_);
+  if (!match) return std::nullopt;
+  return poses_[*match].pose;
+}
+
 }  // namespace obsgroup::io

@@ -87,7 +87,7 @@ struct DepthOptions {
   std::optional<double> depth_scale;  ///< units per metre; default from the layout
   std::optional<double> max_depth;    ///< metres; deeper pixels are no return
   int stride = 1;                     ///< every stride-th pixel in u and v
-  double max_time_difference = 0.02;  ///< TUM: seconds between a frame and its pose
+  double max_time_difference = kDefaultMaxTimeDifference;  ///< TUM: seconds between a frame and its pose
   std::optional<std::string> poses;   ///< TUM: instead of groundtruth.txt
   /// The world's up axis; default: z for TUM (its motion-capture world has
   /// z up), Auto for Redwood.

@@ -47,6 +47,29 @@ PoseFormat detectPoseFormat(std::string_view content, const std::string& path);
 /// nothing. `poses` sorted by stamp.
 std::optional<std::size_t> nearestStamp(const std::vector<StampedPose>& poses, double stamp, double tolerance);
 
+/// How far apart, in seconds, a frame's time and its pose's stamp may be by
+/// default: a TUM RGB-D ground truth at 100 Hz puts one within 5 ms of every
+/// frame; a few missed poses are still matched.
+inline constexpr double kDefaultMaxTimeDifference = 0.02;
+
+/// Poses by time: TUM poses sorted by stamp, each looked up at the stamp
+/// nearest a time within a tolerance. PCD files named by their time, TUM
+/// RGB-D depth frames and bag messages given a poses file are all matched
+/// to their poses this way.
+class StampedPoseIndex {
+ public:
+  /// `poses` in any order (sorted here, stably: of equal stamps the first
+  /// in the file is found); `tolerance` in seconds.
+  StampedPoseIndex(std::vector<StampedPose> poses, double tolerance);
+  /// The pose whose stamp is nearest `stamp`, if within the tolerance.
+  std::optional<Eigen::Isometry3d> at(double stamp) const;
+  double tolerance() const { return tolerance_; }
+
+ private:
+  std::vector<StampedPose> poses_;
+  double tolerance_;
+};
+
 /// The rotation of a quaternion given as (w, x, y, z), normalised; throws
 /// std::invalid_argument when its norm is not within 1% of 1.
 Eigen::Quaterniond checkedQuaternion(double w, double x, double y, double z);

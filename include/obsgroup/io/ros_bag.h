@@ -10,6 +10,7 @@
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
 #include <obsgroup/io/pcd_sequence.h>
+#include <obsgroup/io/pose_file.h>
 
 #include <pcl/point_types.h>
 
@@ -39,7 +40,7 @@ struct BagOptions {
   /// or not) instead: each message takes the pose nearest its stamp within
   /// max_time_difference, as a SLAM system's output would give it.
   std::optional<std::string> poses_file;
-  double max_time_difference = 0.02;  ///< seconds
+  double max_time_difference = kDefaultMaxTimeDifference;  ///< seconds
 };
 
 /// The observations of a bag, with what was read and how.
