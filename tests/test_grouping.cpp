@@ -2,6 +2,7 @@
 #include "test_support.h"
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/online_grouping.h>
 
 #include <gtest/gtest.h>
 
@@ -113,4 +114,25 @@ TEST(ObservationGrouping, PartitionOptionsSetLaterKeepTheThreadsAndTheInterruptF
   g.setNumberOfThreads(2);
   EXPECT_EQ(g.getPartitionOptions().threads, 2);
   EXPECT_EQ(g.getSensedSpaceOverlap().getNumberOfThreads(), 2);
+}
+
+// Every setting reads back as it was set.
+TEST(ObservationGrouping, EverySetterHasItsGetter) {
+  ObservationGrouping<pcl::PointXYZ> g;
+  InterruptFlag flag{false};
+  g.setInterruptFlag(&flag);
+  EXPECT_EQ(g.getInterruptFlag(), &flag);
+  g.setProgressCallback([](std::size_t, std::size_t) {});
+  EXPECT_TRUE(bool(g.getProgressCallback()));
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setNcutThreshold(0.4);
+  online.setSplitCriterion(SplitCriterion::Mean);
+  online.setMinGroupSize(3);
+  online.setMaxDepth(5);
+  online.setInterruptFlag(&flag);
+  EXPECT_EQ(online.getNcutThreshold(), 0.4);
+  EXPECT_EQ(online.getSplitCriterion(), SplitCriterion::Mean);
+  EXPECT_EQ(online.getMinGroupSize(), 3);
+  EXPECT_EQ(online.getMaxDepth(), 5);
+  EXPECT_EQ(online.getInterruptFlag(), &flag);
 }

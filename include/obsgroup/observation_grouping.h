@@ -89,9 +89,11 @@ class ObservationGrouping {
   void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
   int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
   void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
+  const ProgressCallback& getProgressCallback() const { return overlap_.getProgressCallback(); }
   /// A flag polled during compute() (see interrupt.h); when it is set,
   /// compute() stops and throws Interrupted. Not owned.
   void setInterruptFlag(const InterruptFlag* flag) { overlap_.setInterruptFlag(flag); }
+  const InterruptFlag* getInterruptFlag() const { return overlap_.getInterruptFlag(); }
 
   // --- graph and partition (sec. II, III) ---
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).

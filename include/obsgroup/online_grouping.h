@@ -145,13 +145,18 @@ class OnlineGrouping {
   /// The partition options (thread count and interrupt flag: this object's).
   PartitionOptions getPartitionOptions() const;
   void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; reconfigure(); }
+  double getNcutThreshold() const { return options_.ncut_threshold; }
   void setSplitCriterion(SplitCriterion criterion) { options_.split = criterion; reconfigure(); }
+  SplitCriterion getSplitCriterion() const { return options_.split; }
   void setMinGroupSize(int size) { options_.min_group_size = size; reconfigure(); }
+  int getMinGroupSize() const { return options_.min_group_size; }
   void setMaxDepth(int depth) { options_.max_depth = depth; reconfigure(); }
+  int getMaxDepth() const { return options_.max_depth; }
   /// Threads for update(); the result does not depend on it.
   void setNumberOfThreads(int threads) { config_.setNumberOfThreads(threads); }
   int getNumberOfThreads() const { return config_.getNumberOfThreads(); }
   void setInterruptFlag(const InterruptFlag* flag) { config_.setInterruptFlag(flag); }
+  const InterruptFlag* getInterruptFlag() const { return config_.getInterruptFlag(); }
   /// Sets every parameter to `grouping`'s (model, regions, delta, voxel,
   /// diagonal, partition options), e.g. those of a command line.
   void setParametersFrom(const ObservationGrouping<PointT>& grouping);

@@ -76,6 +76,7 @@ class SensedSpaceOverlap {
   /// Called as observations are matched (the overlap stage can take minutes
   /// on big logs); empty by default.
   void setProgressCallback(ProgressCallback callback) { progress_ = std::move(callback); }
+  const ProgressCallback& getProgressCallback() const { return progress_; }
 
   /// A flag polled during compute(); when it is set, compute() stops and
   /// throws Interrupted. Not owned; null (the default) disables polling.
