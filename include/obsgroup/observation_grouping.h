@@ -48,11 +48,15 @@ class ObservationGrouping {
     overlap_.setSensedSpaceModel(SensedSpaceModel::Visibility);
     options_.split = SplitCriterion::BestNcut;
     options_.ncut_threshold = kDefaultNcutThreshold;
+    options_.boundary_passes = kDefaultBoundaryPasses;
   }
 
   /// The Ncut threshold of the defaults: the paper's 1 splits any group whose
   /// overlap is not uniform (see docs/method.md); 0.7 keeps rooms whole.
   static constexpr double kDefaultNcutThreshold = 0.7;
+  /// Sweeps of the boundary refinement of the defaults (PartitionOptions::
+  /// boundary_passes): doorway scans join the room their overlap says.
+  static constexpr int kDefaultBoundaryPasses = 3;
 
   /// The paper's method exactly: the points model of eq. (16)-(18), the mean
   /// split of sec. II-A and the Ncut threshold 1 of sec. II-B (delta as set).
@@ -60,6 +64,7 @@ class ObservationGrouping {
     overlap_.setSensedSpaceModel(SensedSpaceModel::Points);
     options_.split = SplitCriterion::Mean;
     options_.ncut_threshold = 1.0;
+    options_.boundary_passes = 0;
   }
 
   /// Adds an observation: points in the sensor frame and the sensor's pose.
@@ -99,6 +104,10 @@ class ObservationGrouping {
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
   void setDiagonalWeight(double value) { diagonal_ = value; }
   double getDiagonalWeight() const { return diagonal_; }
+  void setMaxCrossRatio(double ratio) { options_.max_cross_ratio = ratio; }
+  double getMaxCrossRatio() const { return options_.max_cross_ratio; }
+  void setBoundaryPasses(int passes) { options_.boundary_passes = passes; }
+  int getBoundaryPasses() const { return options_.boundary_passes; }
   void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; }
   double getNcutThreshold() const { return options_.ncut_threshold; }
   void setSplitCriterion(SplitCriterion criterion) { options_.split = criterion; }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -28,6 +29,7 @@ std::string toString(SplitNode::Outcome outcome) {
     case SplitNode::Outcome::MaxDepth: return "max_depth";
     case SplitNode::Outcome::TooFewNodes: return "too_few_nodes";
     case SplitNode::Outcome::EigenSolverFailed: return "eigen_solver_failed";
+    case SplitNode::Outcome::CutNotNarrow: return "cut_not_narrow";
   }
   return "?";
 }
@@ -213,8 +215,28 @@ class Partitioner {
     }
     Bisection b;
     if (!bisect(sub, members, min_size, b, d)) return d;
-    judgeBisection(b, members, min_size, current.depth, d);
+    judgeBisection(b, sub, members, min_size, current.depth, d);
     return d;
+  }
+
+  /// Median weight of the pairs the bisection separates over the median of
+  /// the pairs it keeps on one side (PartitionOptions::max_cross_ratio), from
+  /// the node's own block: O(nnz) with nth_element.
+  static double crossRatio(const WeightMatrix& sub, const std::vector<bool>& in_a) {
+    std::vector<double> cross, kept;
+    for (Eigen::Index c = 0; c < sub.outerSize(); ++c)
+      for (WeightMatrix::InnerIterator it(sub, c); it; ++it)
+        if (it.row() < c) (in_a[it.row()] != in_a[c] ? cross : kept).push_back(it.value());
+    if (cross.empty()) return 0.0;
+    if (kept.empty()) return std::numeric_limits<double>::infinity();
+    return median(cross) / median(kept);
+  }
+
+  /// The lower median for an even count.
+  static double median(std::vector<double>& v) {
+    const auto mid = v.begin() + (v.size() - 1) / 2;
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
   }
 
   /// A disconnected graph is split into its components first: their Ncut is
@@ -264,16 +286,19 @@ class Partitioner {
     return true;
   }
 
-  /// Accepts the bisection while Ncut < the threshold and both sides are
-  /// large enough (sec. II-B), else says why not.
-  void judgeBisection(const Bisection& b, const std::vector<int>& members, int min_size, int depth,
-                      Decision& d) const {
+  /// Accepts the bisection while Ncut < the threshold (sec. II-B), the cut is
+  /// narrow enough when max_cross_ratio asks, and both sides are large
+  /// enough; else says why not.
+  void judgeBisection(const Bisection& b, const WeightMatrix& sub, const std::vector<int>& members, int min_size,
+                      int depth, Decision& d) const {
     std::vector<int> a, rest;
     for (std::size_t k = 0; k < members.size(); ++k) (b.in_a[k] ? a : rest).push_back(members[k]);
     if (!b.valid) {
       d.node.outcome = SplitNode::Outcome::NoSplit;
     } else if (!(b.cut.ncut < options_.ncut_threshold)) {
       d.node.outcome = SplitNode::Outcome::NcutAboveThreshold;
+    } else if (options_.max_cross_ratio > 0.0 && !(crossRatio(sub, b.in_a) < options_.max_cross_ratio)) {
+      d.node.outcome = SplitNode::Outcome::CutNotNarrow;
     } else if (static_cast<int>(a.size()) < min_size || static_cast<int>(rest.size()) < min_size) {
       d.node.outcome = SplitNode::Outcome::GroupTooSmall;
     } else {
@@ -326,6 +351,58 @@ void checkWeights(const WeightMatrix& W) {
   }
 }
 
+/// PartitionOptions::boundary_passes: each observation joins the group with
+/// the highest mean weight to it (its own group counted without itself),
+/// every observation decided from the previous sweep's groups, so that the
+/// result does not depend on an order of visit; a tie keeps the observation
+/// where it is, else goes to the lowest group index. O(passes * nnz(W)).
+void refineBoundaries(const WeightMatrix& W, int passes, Partition& p) {
+  const int n = static_cast<int>(W.rows());
+  std::vector<int> group_of = p.group_of;
+  const int k_groups = static_cast<int>(p.groups.size());
+  std::vector<double> sum(k_groups, 0.0);
+  std::vector<int> touched;
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<int> size(k_groups, 0);
+    for (int g : group_of) ++size[g];
+    std::vector<int> next = group_of;
+    bool moved = false;
+    for (int i = 0; i < n; ++i) {
+      touched.clear();
+      for (WeightMatrix::InnerIterator it(W, i); it; ++it) {
+        if (it.row() == i) continue;  // the diagonal says nothing of i's group
+        const int g = group_of[it.row()];
+        if (sum[g] == 0.0) touched.push_back(g);
+        sum[g] += it.value();
+      }
+      const int own = group_of[i];
+      const double own_mean = size[own] > 1 ? sum[own] / (size[own] - 1) : 0.0;
+      int best = own;
+      double best_mean = own_mean;
+      std::sort(touched.begin(), touched.end());
+      for (int g : touched) {
+        if (g == own) continue;
+        const double mean = sum[g] / size[g];
+        if (mean > best_mean) best = g, best_mean = mean;
+      }
+      for (int g : touched) sum[g] = 0.0;
+      if (best != own) next[i] = best, moved = true;
+    }
+    group_of = std::move(next);
+    if (!moved) break;
+  }
+  std::vector<std::vector<int>> groups(k_groups);
+  for (int i = 0; i < n; ++i) groups[group_of[i]].push_back(i);
+  groups.erase(std::remove_if(groups.begin(), groups.end(), [](const std::vector<int>& g) { return g.empty(); }),
+               groups.end());
+  std::sort(groups.begin(), groups.end(),
+            [](const std::vector<int>& a, const std::vector<int>& b) { return a.front() < b.front(); });
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int i : groups[g]) group_of[i] = static_cast<int>(g);
+  p.groups = std::move(groups);
+  p.group_of = std::move(group_of);
+}
+
 }  // namespace
 
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options) {
@@ -333,7 +410,9 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
   checkWeights(W);
-  return Partitioner(W, options).run();
+  Partition partition = Partitioner(W, options).run();
+  if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, partition);
+  return partition;
 }
 
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
@@ -353,6 +432,8 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   try {
     Partition partition = Partitioner(W, options, &reuse).run();
     cache.store_ = std::move(next);
+    // After the tree, from all of W: the same as the batch's, whatever was reused.
+    if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, partition);
     return partition;
   } catch (...) {
     cache.clear();  // partly moved on: the next run computes every node

@@ -24,6 +24,21 @@ struct PartitionOptions {
   int min_group_size = 1;
   /// Bisections deeper than this are not attempted (components still split).
   int max_depth = std::numeric_limits<int>::max();
+  /// Sweeps of the boundary refinement after the split tree (0: none, the
+  /// paper's; the split tree's leaves are then the groups). In a sweep every
+  /// observation joins the group whose other members it overlaps most on
+  /// average (mean Psi, eq. 18), all at once from the previous sweep's
+  /// groups; sweeps stop early when nothing moves. A scan standing in a
+  /// doorway sees both sides, and the bisection puts it on either; its mean
+  /// overlap is higher with the members of its own room (docs/method.md).
+  int boundary_passes = 0;
+  /// A bisection is accepted only while the median weight of the pairs it
+  /// separates is below this share of the median weight of the pairs it keeps
+  /// together (0: no such test, the paper's). Ncut sums weights, so a small
+  /// room beside a large one or a room the size of the sensor's range is cut
+  /// or kept by its size; this ratio compares typical overlaps, which a door
+  /// lowers and open floor does not, whatever the size (docs/method.md).
+  double max_cross_ratio = 0.0;
   /// Keep each node's eigenvector in the split tree (for plots and analysis).
   bool keep_eigenvectors = true;
   /// Threads over the nodes of one level of the split tree (0: OpenMP's
@@ -50,7 +65,8 @@ struct SplitNode {
     NoSplit,           ///< Bisection computed, all nodes on one side.
     MaxDepth,          ///< Not attempted: max_depth reached.
     TooFewNodes,       ///< Not attempted: a single node, or fewer than 2 * min_group_size.
-    EigenSolverFailed  ///< No eigen solver converged: kept whole, with a warning.
+    EigenSolverFailed, ///< No eigen solver converged: kept whole, with a warning.
+    CutNotNarrow       ///< Bisection computed, its separated pairs overlap too much (max_cross_ratio).
   };
   std::vector<int> members;   ///< Observation indices, ascending.
   Kind kind = Kind::Leaf;
@@ -77,7 +93,9 @@ struct Partition {
   std::vector<std::vector<int>> groups;
   /// group_of[i] is the group of observation i.
   std::vector<int> group_of;
-  /// The split tree in breadth-first order; splits[0] is the root.
+  /// The split tree in breadth-first order; splits[0] is the root. Its
+  /// leaves are the groups unless PartitionOptions::boundary_passes moved
+  /// observations between them.
   std::vector<SplitNode> splits;
   /// Things the user should know, in split-tree order: an eigen solve that
   /// fell back to the dense solver, or failed and left a node whole.
