@@ -182,7 +182,6 @@ struct Configuration {
   int min_group_size = 1;
   double ncut_threshold = ObservationGrouping<pcl::PointXYZ>::kDefaultNcutThreshold;
   int boundary_passes = ObservationGrouping<pcl::PointXYZ>::kDefaultBoundaryPasses;
-  double max_cross_ratio = ObservationGrouping<pcl::PointXYZ>().getMaxCrossRatio();
   int threads = 0;  ///< 0: all cores
 
   /// The page's row label: the model (with δ for points) and the split; the
@@ -190,14 +189,12 @@ struct Configuration {
   std::string label() const {
     const std::string delta = model == SensedSpaceModel::Points ? format(" δ %g m", match_distance) : std::string();
     const bool paper = model == SensedSpaceModel::Points && split == SplitCriterion::Mean && ncut_threshold == 1.0 &&
-                       boundary_passes == 0 && max_cross_ratio == 0.0;
+                       boundary_passes == 0;
     const ObservationGrouping<pcl::PointXYZ> defaults;
     const bool library_default = model == defaults.getSensedSpaceModel() && split == defaults.getSplitCriterion() &&
                                  ncut_threshold == defaults.getNcutThreshold() &&
-                                 boundary_passes == defaults.getBoundaryPasses() &&
-                                 max_cross_ratio == defaults.getMaxCrossRatio();
+                                 boundary_passes == defaults.getBoundaryPasses();
     return toString(model) + delta + ", split " + toString(split) + format(", Ncut < %g", ncut_threshold) +
-           (max_cross_ratio > 0 ? format(", cross ratio < %g", max_cross_ratio) : std::string()) +
            (boundary_passes > 0 ? format(", %d boundary passes", boundary_passes) : std::string()) +
            (paper ? " (the paper)" : "") + (library_default ? " (**the default**)" : "");
   }
@@ -205,10 +202,10 @@ struct Configuration {
   /// Every parameter, for the summary line of a sweep.
   std::string parameters() const {
     return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
-                  "min-group-size=%d ncut-threshold=%g boundary-passes=%d max-cross-ratio=%g",
+                  "min-group-size=%d ncut-threshold=%g boundary-passes=%d",
                   toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
                   region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
-                  min_group_size, ncut_threshold, boundary_passes, max_cross_ratio);
+                  min_group_size, ncut_threshold, boundary_passes);
   }
 };
 
@@ -236,7 +233,6 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
   options.min_group_size = c.min_group_size;
   options.ncut_threshold = c.ncut_threshold;
   options.boundary_passes = c.boundary_passes;
-  options.max_cross_ratio = c.max_cross_ratio;
   options.keep_eigenvectors = false;  // only the groups are measured
   grouping.setPartitionOptions(options);
   grouping.setNumberOfThreads(c.threads);
@@ -624,7 +620,6 @@ const char* kUsage =
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
-    "  --max-cross-ratio X\n"
     "  --threads N (0: all cores)\n"
     "selection (defaults: all):\n"
     "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth  --poses exact,drift\n"
@@ -671,7 +666,6 @@ int main(int argc, char** argv) {
         {"--min-group-size", integer(configuration.min_group_size)},
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--boundary-passes", integer(configuration.boundary_passes)},
-        {"--max-cross-ratio", number(configuration.max_cross_ratio)},
         {"--threads", integer(configuration.threads)},
         {"--write-logs", [&](const std::string&, const std::string& v) { write_logs = v; }},
         {"--sweep",
@@ -777,7 +771,7 @@ int main(int argc, char** argv) {
         c.ncut_threshold = threshold;
         // The paper's row is the paper's method: no boundary refinement.
         if (m == SensedSpaceModel::Points && s == SplitCriterion::Mean && threshold == 1.0)
-          c.boundary_passes = 0, c.max_cross_ratio = 0.0;
+          c.boundary_passes = 0;
         configurations.push_back(c);
       }
   const std::string report = page(datasets, configurations, generation_seconds);

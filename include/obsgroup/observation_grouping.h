@@ -104,8 +104,6 @@ class ObservationGrouping {
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
   void setDiagonalWeight(double value) { diagonal_ = value; }
   double getDiagonalWeight() const { return diagonal_; }
-  void setMaxCrossRatio(double ratio) { options_.max_cross_ratio = ratio; }
-  double getMaxCrossRatio() const { return options_.max_cross_ratio; }
   void setBoundaryPasses(int passes) { options_.boundary_passes = passes; }
   int getBoundaryPasses() const { return options_.boundary_passes; }
   void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; }

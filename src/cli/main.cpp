@@ -181,12 +181,6 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->check(finiteNumber(0.0, false, 2.0))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--max-cross-ratio", args.max_cross_ratio,
-                     "accept a bisection only while the median overlap of the pairs it separates is below this "
-                     "share of the median of the pairs it keeps (0: no such test, the paper's)")
-      ->check(finiteNumber(0.0, false, 10.0))
-      ->capture_default_str()
-      ->group("Method");
   command.add_option("--boundary-passes", args.boundary_passes,
                      "sweeps after the split tree moving each observation to the group it overlaps most on "
                      "average (0: none, the paper's)")
@@ -294,11 +288,8 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
     args.split = SplitCriterion::Mean;
     if (partition.count("--boundary-passes") && args.boundary_passes != 0)
       return "--paper uses --boundary-passes 0; drop one of them";
-    if (partition.count("--max-cross-ratio") && args.max_cross_ratio != 0.0)
-      return "--paper uses --max-cross-ratio 0; drop one of them";
     args.ncut_threshold = 1.0;
     args.boundary_passes = 0;
-    args.max_cross_ratio = 0.0;
   }
   // Options of one model given with another are a mistake, not a no-op.
   const bool points = args.sso == SensedSpaceModel::Points;

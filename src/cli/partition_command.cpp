@@ -136,7 +136,6 @@ void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& g
   grouping.setNcutThreshold(args.ncut_threshold);
   grouping.setSplitCriterion(args.split);
   grouping.setBoundaryPasses(args.boundary_passes);
-  grouping.setMaxCrossRatio(args.max_cross_ratio);
   grouping.setMinGroupSize(args.min_group_size);
   if (args.max_depth) grouping.setMaxDepth(*args.max_depth);
   grouping.setNumberOfThreads(args.threads);
@@ -260,7 +259,6 @@ nlohmann::json methodParameters(const PartitionArgs& args, double diagonal, doub
   p["ncut_threshold"] = args.ncut_threshold;
   p["split"] = toString(args.split);
   p["boundary_passes"] = args.boundary_passes;
-  p["max_cross_ratio"] = args.max_cross_ratio;
   p["min_group_size"] = args.min_group_size;
   p["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
   p["diagonal"] = diagonal;

@@ -59,7 +59,6 @@ struct PartitionArgs {
   double voxel = 0.0;
   double ncut_threshold = 0.7;  ///< ObservationGrouping::kDefaultNcutThreshold
   SplitCriterion split = SplitCriterion::BestNcut;
-  double max_cross_ratio = 0.0;
   int boundary_passes = 3;  ///< ObservationGrouping::kDefaultBoundaryPasses; --paper: 0
   int min_group_size = 1;
   std::optional<int> max_depth;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -29,7 +28,6 @@ std::string toString(SplitNode::Outcome outcome) {
     case SplitNode::Outcome::MaxDepth: return "max_depth";
     case SplitNode::Outcome::TooFewNodes: return "too_few_nodes";
     case SplitNode::Outcome::EigenSolverFailed: return "eigen_solver_failed";
-    case SplitNode::Outcome::CutNotNarrow: return "cut_not_narrow";
   }
   return "?";
 }
@@ -215,28 +213,8 @@ class Partitioner {
     }
     Bisection b;
     if (!bisect(sub, members, min_size, b, d)) return d;
-    judgeBisection(b, sub, members, min_size, current.depth, d);
+    judgeBisection(b, members, min_size, current.depth, d);
     return d;
-  }
-
-  /// Median weight of the pairs the bisection separates over the median of
-  /// the pairs it keeps on one side (PartitionOptions::max_cross_ratio), from
-  /// the node's own block: O(nnz) with nth_element.
-  static double crossRatio(const WeightMatrix& sub, const std::vector<bool>& in_a) {
-    std::vector<double> cross, kept;
-    for (Eigen::Index c = 0; c < sub.outerSize(); ++c)
-      for (WeightMatrix::InnerIterator it(sub, c); it; ++it)
-        if (it.row() < c) (in_a[it.row()] != in_a[c] ? cross : kept).push_back(it.value());
-    if (cross.empty()) return 0.0;
-    if (kept.empty()) return std::numeric_limits<double>::infinity();
-    return median(cross) / median(kept);
-  }
-
-  /// The lower median for an even count.
-  static double median(std::vector<double>& v) {
-    const auto mid = v.begin() + (v.size() - 1) / 2;
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
   }
 
   /// A disconnected graph is split into its components first: their Ncut is
@@ -286,19 +264,16 @@ class Partitioner {
     return true;
   }
 
-  /// Accepts the bisection while Ncut < the threshold (sec. II-B), the cut is
-  /// narrow enough when max_cross_ratio asks, and both sides are large
-  /// enough; else says why not.
-  void judgeBisection(const Bisection& b, const WeightMatrix& sub, const std::vector<int>& members, int min_size,
-                      int depth, Decision& d) const {
+  /// Accepts the bisection while Ncut < the threshold and both sides are
+  /// large enough (sec. II-B), else says why not.
+  void judgeBisection(const Bisection& b, const std::vector<int>& members, int min_size, int depth,
+                      Decision& d) const {
     std::vector<int> a, rest;
     for (std::size_t k = 0; k < members.size(); ++k) (b.in_a[k] ? a : rest).push_back(members[k]);
     if (!b.valid) {
       d.node.outcome = SplitNode::Outcome::NoSplit;
     } else if (!(b.cut.ncut < options_.ncut_threshold)) {
       d.node.outcome = SplitNode::Outcome::NcutAboveThreshold;
-    } else if (options_.max_cross_ratio > 0.0 && !(crossRatio(sub, b.in_a) < options_.max_cross_ratio)) {
-      d.node.outcome = SplitNode::Outcome::CutNotNarrow;
     } else if (static_cast<int>(a.size()) < min_size || static_cast<int>(rest.size()) < min_size) {
       d.node.outcome = SplitNode::Outcome::GroupTooSmall;
     } else {

@@ -32,13 +32,6 @@ struct PartitionOptions {
   /// doorway sees both sides, and the bisection puts it on either; its mean
   /// overlap is higher with the members of its own room (docs/method.md).
   int boundary_passes = 0;
-  /// A bisection is accepted only while the median weight of the pairs it
-  /// separates is below this share of the median weight of the pairs it keeps
-  /// together (0: no such test, the paper's). Ncut sums weights, so a small
-  /// room beside a large one or a room the size of the sensor's range is cut
-  /// or kept by its size; this ratio compares typical overlaps, which a door
-  /// lowers and open floor does not, whatever the size (docs/method.md).
-  double max_cross_ratio = 0.0;
   /// Keep each node's eigenvector in the split tree (for plots and analysis).
   bool keep_eigenvectors = true;
   /// Threads over the nodes of one level of the split tree (0: OpenMP's
@@ -65,8 +58,7 @@ struct SplitNode {
     NoSplit,           ///< Bisection computed, all nodes on one side.
     MaxDepth,          ///< Not attempted: max_depth reached.
     TooFewNodes,       ///< Not attempted: a single node, or fewer than 2 * min_group_size.
-    EigenSolverFailed, ///< No eigen solver converged: kept whole, with a warning.
-    CutNotNarrow       ///< Bisection computed, its separated pairs overlap too much (max_cross_ratio).
+    EigenSolverFailed  ///< No eigen solver converged: kept whole, with a warning.
   };
   std::vector<int> members;   ///< Observation indices, ascending.
   Kind kind = Kind::Leaf;
