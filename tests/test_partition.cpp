@@ -173,3 +173,34 @@ TEST(RecursivePartition, RealOfficeLogRefinesMrptsGroups) {
   }
   EXPECT_GE(agreeing, 0.85 * 72) << agreeing << " of 72 scans agree";
 }
+
+// The boundary refinement (PartitionOptions::boundary_passes) on a graph
+// whose answer is known: a large room A (observations 0-9, a clique of weight
+// 1), a small room B (10-12, the same) and a doorway observation 13 that
+// overlaps each of A's members at 0.3 and each of B's at 0.5. Ncut sums the
+// weights, so the tree keeps it with A (cut 1.5 against 3.0); by its mean
+// overlap (0.3 against 0.5) it belongs to B, and the refinement moves it.
+TEST(RecursivePartition, BoundaryRefinementMovesAnObservationToTheGroupItOverlapsMostOnAverage) {
+  std::vector<WeightedPair> pairs;
+  for (auto [first, last] : {std::pair<int, int>{0, 10}, std::pair<int, int>{10, 13}})
+    for (int i = first; i < last; ++i)
+      for (int j = i + 1; j < last; ++j) pairs.push_back({i, j, 1.0});
+  for (int i = 0; i < 10; ++i) pairs.push_back({i, 13, 0.3});
+  for (int i = 10; i < 13; ++i) pairs.push_back({i, 13, 0.5});
+  const WeightMatrix W = buildWeightMatrix(14, pairs);
+  PartitionOptions options;
+  options.split = SplitCriterion::BestNcut;
+  options.ncut_threshold = 0.7;
+  const Partition tree = recursivePartition(W, options);
+  ASSERT_EQ(tree.groups.size(), 2u);
+  EXPECT_EQ(tree.group_of[13], tree.group_of[0]);
+  options.boundary_passes = 3;
+  for (int threads : {1, 2}) {
+    options.threads = threads;
+    const Partition refined = recursivePartition(W, options);
+    ASSERT_EQ(refined.groups.size(), 2u);
+    EXPECT_EQ(refined.groups[0], std::vector<int>({0, 1, 2, 3, 4, 5, 6, 7, 8, 9}));
+    EXPECT_EQ(refined.groups[1], std::vector<int>({10, 11, 12, 13}));
+    EXPECT_EQ(refined.splits.size(), tree.splits.size());  // the tree is kept as it was
+  }
+}
