@@ -418,9 +418,13 @@ LabelledDataset readLabelledLog(const LabelledLog&) {
 #endif
 
 /// Groups each labelled log and scores the groups against its labels: a
-/// line per log and a summary line.
-int evaluateLabelledLogs(const std::vector<LabelledDataset>& logs, const Configuration& c) {
+/// line per log and a summary line, or (with `output`) a table into the
+/// page's "labelled" section, each log named by its file name alone.
+int evaluateLabelledLogs(const std::vector<LabelledDataset>& logs, const Configuration& c,
+                         const std::string& output = "") {
   int rooms = 0, found = 0, pure = 0, errors = 0;
+  std::ostringstream table;
+  table << "| log | scans | groups | ARI vs labels | rooms found | rooms pure |\n|---|---|---|---|---|---|\n";
   for (const LabelledDataset& d : logs) {
     try {
       const auto start = std::chrono::steady_clock::now();
@@ -434,6 +438,10 @@ int evaluateLabelledLogs(const std::vector<LabelledDataset>& logs, const Configu
                           d.name.c_str(), d.observations.size(), p.groups.size(),
                           sim::adjustedRandIndex(d.place_of, p.group_of), scores.found, scores.rooms, scores.pure,
                           scores.rooms, seconds);
+      const std::string name = d.name.substr(d.name.find_last_of('/') + 1);
+      table << format("| %s | %zu | %zu | %.3f | %d of %d | %d of %d |\n", name.c_str(), d.observations.size(),
+                      p.groups.size(), sim::adjustedRandIndex(d.place_of, p.group_of), scores.found, scores.rooms,
+                      scores.pure, scores.rooms);
     } catch (const std::exception& e) {
       ++errors;
       std::cout << format("%-40s error: %s\n", d.name.c_str(), e.what());
@@ -441,7 +449,11 @@ int evaluateLabelledLogs(const std::vector<LabelledDataset>& logs, const Configu
   }
   std::cout << format("summary %s: rooms found %d/%d  pure %d/%d%s\n", c.parameters().c_str(), found, rooms, pure,
                       rooms, errors ? format("  %d ERRORS", errors).c_str() : "");
-  return errors ? 1 : 0;
+  if (errors) return 1;
+  if (output.empty()) return 0;
+  table << format("| all | | | | %d of %d | %d of %d |\n\nParameters: %s.\n", found, rooms, pure, rooms,
+                  c.parameters().c_str());
+  return writeGeneratedSection(output, table.str(), "labelled");
 }
 
 /// Rooms found and pure over simulated and labelled datasets.
@@ -614,7 +626,7 @@ int parseInteger(const std::string& flag, const std::string& text) {
 const char* kUsage =
     "usage: evaluate_grouping [--output FILE] [parameters] [selection]\n"
     "       evaluate_grouping --model M [--split S] [parameters] [selection]\n"
-    "Without --model: the page's twelve configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's).\n"
+    "Without --model: the page's thirteen configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's; the default without boundary refinement).\n"
     "With --model or --split: that one configuration (unset: the library's default), a line per dataset and a summary line.\n"
     "parameters (defaults: the library's):\n"
     "  --model points|free-space|visibility   --split mean|sign|best\n"
@@ -701,7 +713,7 @@ int main(int argc, char** argv) {
       if (it == options.end() || a + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + flag);
       it->second(flag, argv[++a]);
     }
-    if ((model || split) && !output.empty() && !sweep)
+    if ((model || split) && !output.empty() && !sweep && logs.empty())
       throw std::invalid_argument("--output writes the page; it takes no --model or --split");
     if (buildings.empty() || sensors.empty() || pose_sources.empty()) throw std::invalid_argument("nothing selected");
     if (logs.size() != label_files.size()) throw std::invalid_argument("each --log needs its --labels");
@@ -731,7 +743,7 @@ int main(int argc, char** argv) {
     const ObservationGrouping<pcl::PointXYZ> defaults;
     configuration.model = model.value_or(defaults.getSensedSpaceModel());
     configuration.split = split.value_or(defaults.getSplitCriterion());
-    return evaluateLabelledLogs(labelled, configuration);
+    return evaluateLabelledLogs(labelled, configuration, output);
   }
 
   const auto start = std::chrono::steady_clock::now();
@@ -774,6 +786,14 @@ int main(int argc, char** argv) {
           c.boundary_passes = 0;
         configurations.push_back(c);
       }
+  // The default without the boundary refinement, to show what it changes.
+  Configuration unrefined = configuration;
+  const ObservationGrouping<pcl::PointXYZ> defaults;
+  unrefined.model = defaults.getSensedSpaceModel();
+  unrefined.split = defaults.getSplitCriterion();
+  unrefined.ncut_threshold = defaults.getNcutThreshold();
+  unrefined.boundary_passes = 0;
+  configurations.push_back(unrefined);
   const std::string report = page(datasets, configurations, generation_seconds);
   if (output.empty()) {
     std::cout << report;
