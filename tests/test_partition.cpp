@@ -203,4 +203,6 @@ TEST(RecursivePartition, BoundaryRefinementMovesAnObservationToTheGroupItOverlap
     EXPECT_EQ(refined.groups[1], std::vector<int>({10, 11, 12, 13}));
     EXPECT_EQ(refined.splits.size(), tree.splits.size());  // the tree is kept as it was
   }
+  options.boundary_passes = -1;
+  EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
 }

@@ -152,6 +152,9 @@ class OnlineGrouping {
   int getMinGroupSize() const { return options_.min_group_size; }
   void setMaxDepth(int depth) { options_.max_depth = depth; reconfigure(); }
   int getMaxDepth() const { return options_.max_depth; }
+  /// Sweeps of the boundary refinement (PartitionOptions::boundary_passes).
+  void setBoundaryPasses(int passes) { options_.boundary_passes = passes; reconfigure(); }
+  int getBoundaryPasses() const { return options_.boundary_passes; }
   /// Threads for update(); the result does not depend on it.
   void setNumberOfThreads(int threads) { config_.setNumberOfThreads(threads); }
   int getNumberOfThreads() const { return config_.getNumberOfThreads(); }

@@ -384,6 +384,8 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
+  if (options.boundary_passes < 0)
+    throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
   checkWeights(W);
   Partition partition = Partitioner(W, options).run();
   if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, partition);
@@ -395,6 +397,8 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
+  if (options.boundary_passes < 0)
+    throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
   if (!options.eigen.elimination_rank.empty())
     throw std::invalid_argument("recursivePartition: a split cache needs each node to order itself (no elimination_rank)");
   if (Eigen::Index(ids.size()) != W.rows() || Eigen::Index(changed.size()) != W.rows())
