@@ -1,5 +1,5 @@
-// Explicit instantiations of LocalMapBuilder (PCL registration: the heaviest
-// headers of the library, kept in this one translation unit).
+// Explicit instantiations of LocalMapBuilder (PCL's filters and transforms on
+// every point type), kept in this one translation unit.
 #include "obsgroup/maps/impl/local_map_builder.hpp"
 #include "obsgroup/cloud/point_types.h"
 

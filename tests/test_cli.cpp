@@ -700,10 +700,15 @@ pid_t startCommand(const std::vector<std::string>& args, int* out_fd, const sigs
   }
   if (out_fd) {
     ::close(fds[1]);
-    *out_fd = fds[0];
+    if (pid < 0) ::close(fds[0]);  // no command started: nothing to read
+    *out_fd = pid < 0 ? -1 : fds[0];
   }
   return pid;
 }
+
+/// What a helper returns when the command could not be started (no pipe or
+/// no fork: a busy machine out of processes): never a pid to signal.
+constexpr int kNotStarted = -1000;
 
 /// The exit code of a finished command: -N when signal N ended it.
 int exitCode(int status) {
@@ -721,6 +726,10 @@ int runInterruptedAfter(const std::vector<std::string>& args, std::chrono::milli
   sigaddset(&child_exit, SIGCHLD);
   ::pthread_sigmask(SIG_BLOCK, &child_exit, &previous);
   const pid_t pid = startCommand(args, nullptr, previous);
+  if (pid <= 0) {
+    ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    return kNotStarted;
+  }
   int status = 0;
   bool ended = false;
   timespec timeout{static_cast<time_t>(delay.count() / 1000), static_cast<long>(delay.count() % 1000) * 1000000L};
@@ -749,7 +758,14 @@ int runInterruptedAtLine(const std::vector<std::string>& args, const std::string
   ::pthread_sigmask(SIG_SETMASK, nullptr, &none);
   int fd = -1;
   const pid_t pid = startCommand(args, &fd, none);
+  if (pid <= 0) return kNotStarted;
   FILE* out = ::fdopen(fd, "r");
+  if (!out) {
+    ::close(fd);
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+    return kNotStarted;
+  }
   char* line = nullptr;
   std::size_t capacity = 0;
   bool sent = false;

@@ -206,3 +206,17 @@ TEST(RecursivePartition, BoundaryRefinementMovesAnObservationToTheGroupItOverlap
   options.boundary_passes = -1;
   EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
 }
+
+// The refinement keeps the minimum group size the tree guarantees.
+TEST(RecursivePartition, BoundaryRefinementKeepsTheMinimumGroupSize) {
+  const auto obs = test::realLog();
+  for (int min_size : {2, 4, 6}) {
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    grouping.setMinGroupSize(min_size);
+    ASSERT_GT(grouping.getBoundaryPasses(), 0);
+    const Partition p = groupScans(grouping, obs);
+    ASSERT_GT(p.groups.size(), 1u);
+    for (const auto& g : p.groups) EXPECT_GE(int(g.size()), min_size) << "minimum " << min_size;
+    expectWellFormed(p, int(obs.size()));
+  }
+}

@@ -331,7 +331,10 @@ void checkWeights(const WeightMatrix& W) {
 /// every observation decided from the previous sweep's groups, so that the
 /// result does not depend on an order of visit; a tie keeps the observation
 /// where it is, else goes to the lowest group index. O(passes * nnz(W)).
-void refineBoundaries(const WeightMatrix& W, int passes, Partition& p) {
+/// With a minimum group size above 1, a move that would leave its group
+/// smaller is not made (observations in index order), so that the groups keep
+/// the size the tree guaranteed; with 1, a group may empty and disappear.
+void refineBoundaries(const WeightMatrix& W, int passes, int min_size, Partition& p) {
   const int n = static_cast<int>(W.rows());
   std::vector<int> group_of = p.group_of;
   const int k_groups = static_cast<int>(p.groups.size());
@@ -341,6 +344,7 @@ void refineBoundaries(const WeightMatrix& W, int passes, Partition& p) {
     std::vector<int> size(k_groups, 0);
     for (int g : group_of) ++size[g];
     std::vector<int> next = group_of;
+    std::vector<int> remaining = size;  // as the moves of this sweep leave them
     bool moved = false;
     for (int i = 0; i < n; ++i) {
       touched.clear();
@@ -361,7 +365,10 @@ void refineBoundaries(const WeightMatrix& W, int passes, Partition& p) {
         if (mean > best_mean) best = g, best_mean = mean;
       }
       for (int g : touched) sum[g] = 0.0;
-      if (best != own) next[i] = best, moved = true;
+      if (best == own || (min_size > 1 && remaining[own] - 1 < min_size)) continue;
+      --remaining[own];
+      next[i] = best;
+      moved = true;
     }
     group_of = std::move(next);
     if (!moved) break;
@@ -388,7 +395,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
   checkWeights(W);
   Partition partition = Partitioner(W, options).run();
-  if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, partition);
+  if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, std::max(1, options.min_group_size), partition);
   return partition;
 }
 
@@ -412,7 +419,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     Partition partition = Partitioner(W, options, &reuse).run();
     cache.store_ = std::move(next);
     // After the tree, from all of W: the same as the batch's, whatever was reused.
-    if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, partition);
+    if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, std::max(1, options.min_group_size), partition);
     return partition;
   } catch (...) {
     cache.clear();  // partly moved on: the next run computes every node

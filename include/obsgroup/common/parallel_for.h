@@ -39,6 +39,7 @@ void parallelForWithScratch(std::size_t n, int threads, int chunk, MakeScratch&&
   // Indices after a failed one are skipped: they cannot change which
   // exception is rethrown, and a failing callback should not be called on.
   std::atomic<std::size_t> first_index{n};
+  std::atomic<bool> no_scratch{false};  // a thread could not make its scratch: nothing more runs
   const long long count = static_cast<long long>(n);
 #pragma omp parallel num_threads(threadCount(threads))
   {
@@ -50,11 +51,13 @@ void parallelForWithScratch(std::size_t n, int threads, int chunk, MakeScratch&&
     } catch (...) {
 #pragma omp critical(obsgroup_parallel_for)
       if (!scratch_failed) scratch_failed = std::current_exception();
-      first_index = 0;
+      no_scratch = true;
     }
 #pragma omp for schedule(dynamic, chunk)
     for (long long i = 0; i < count; ++i) {
-      if (!scratch || static_cast<std::size_t>(i) > first_index.load(std::memory_order_relaxed)) continue;
+      if (!scratch || no_scratch.load(std::memory_order_relaxed) ||
+          static_cast<std::size_t>(i) > first_index.load(std::memory_order_relaxed))
+        continue;
       try {
         body(static_cast<std::size_t>(i), *scratch);
       } catch (...) {
