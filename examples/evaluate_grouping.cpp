@@ -180,20 +180,20 @@ struct Configuration {
   double match_distance = 0.1;  ///< delta of the points model: the paper's
   RegionParameters region;      ///< of the free-space and visibility models
   int min_group_size = 1;
-  double ncut_threshold = ObservationGrouping<pcl::PointXYZ>::kDefaultNcutThreshold;
-  int boundary_passes = ObservationGrouping<pcl::PointXYZ>::kDefaultBoundaryPasses;
+  double ncut_threshold = GroupingParameters{}.ncut_threshold;
+  int boundary_passes = GroupingParameters{}.boundary_passes;
   int threads = 0;  ///< 0: all cores
 
   /// The page's row label: the model (with δ for points) and the split; the
   /// region parameters are common to all rows and stated once.
   std::string label() const {
     const std::string delta = model == SensedSpaceModel::Points ? format(" δ %g m", match_distance) : std::string();
-    const bool paper = model == SensedSpaceModel::Points && split == SplitCriterion::Mean && ncut_threshold == 1.0 &&
-                       boundary_passes == 0;
-    const ObservationGrouping<pcl::PointXYZ> defaults;
-    const bool library_default = model == defaults.getSensedSpaceModel() && split == defaults.getSplitCriterion() &&
-                                 ncut_threshold == defaults.getNcutThreshold() &&
-                                 boundary_passes == defaults.getBoundaryPasses();
+    const auto same_method = [this](const GroupingParameters& p) {
+      return model == p.model && split == p.split && ncut_threshold == p.ncut_threshold &&
+             boundary_passes == p.boundary_passes;
+    };
+    const bool paper = same_method(GroupingParameters::paper());
+    const bool library_default = same_method(GroupingParameters{});
     return toString(model) + delta + ", split " + toString(split) + format(", Ncut < %g", ncut_threshold) +
            (boundary_passes > 0 ? format(", %d boundary passes", boundary_passes) : std::string()) +
            (paper ? " (the paper)" : "") + (library_default ? " (**the default**)" : "");
@@ -225,17 +225,19 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
                 std::size_t* warnings = nullptr) {
   ObservationGrouping<pcl::PointXYZ> grouping;
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-  grouping.setSensedSpaceModel(c.model);
-  grouping.setRegionParameters(c.region);
-  grouping.setMatchDistance(c.match_distance);
-  PartitionOptions options = grouping.getPartitionOptions();
-  options.split = c.split;
-  options.min_group_size = c.min_group_size;
-  options.ncut_threshold = c.ncut_threshold;
-  options.boundary_passes = c.boundary_passes;
-  options.keep_eigenvectors = false;  // only the groups are measured
-  grouping.setPartitionOptions(options);
-  grouping.setNumberOfThreads(c.threads);
+  GroupingParameters params;
+  params.model = c.model;
+  // Each model is given only what it uses: the rest would be refused.
+  if (c.model == SensedSpaceModel::Points)
+    params.match_distance = c.match_distance;
+  else
+    params.regions = c.region;
+  params.split = c.split;
+  params.min_group_size = c.min_group_size;
+  params.ncut_threshold = c.ncut_threshold;
+  params.boundary_passes = c.boundary_passes;
+  params.threads = c.threads;
+  grouping.setParameters(params);
   Partition p = grouping.compute();
   if (warnings) *warnings = grouping.getWarnings().size();
   return p;
@@ -740,9 +742,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!labelled.empty() && !sweep) {
-    const ObservationGrouping<pcl::PointXYZ> defaults;
-    configuration.model = model.value_or(defaults.getSensedSpaceModel());
-    configuration.split = split.value_or(defaults.getSplitCriterion());
+    const GroupingParameters defaults;
+    configuration.model = model.value_or(defaults.model);
+    configuration.split = split.value_or(defaults.split);
     return evaluateLabelledLogs(labelled, configuration, output);
   }
 
@@ -751,9 +753,9 @@ int main(int argc, char** argv) {
   const double generation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (sweep) {
-    const ObservationGrouping<pcl::PointXYZ> defaults;
-    configuration.model = model.value_or(defaults.getSensedSpaceModel());
-    configuration.split = split.value_or(defaults.getSplitCriterion());
+    const GroupingParameters defaults;
+    configuration.model = model.value_or(defaults.model);
+    configuration.split = split.value_or(defaults.split);
     const std::string table = "Each default at 75% and 125% of its value, everything else at the defaults; " +
                               format("%zu simulated datasets, %zu labelled logs.\n\n", datasets.size(),
                                      labelled.size()) +
@@ -765,9 +767,9 @@ int main(int argc, char** argv) {
     return writeGeneratedSection(output, table, "sweep");
   }
   if (model || split) {
-    const ObservationGrouping<pcl::PointXYZ> defaults;
-    configuration.model = model.value_or(defaults.getSensedSpaceModel());
-    configuration.split = split.value_or(defaults.getSplitCriterion());
+    const GroupingParameters defaults;
+    configuration.model = model.value_or(defaults.model);
+    configuration.split = split.value_or(defaults.split);
     std::cout << format("# %zu datasets generated in %.1f s\n", datasets.size(), generation_seconds);
     return evaluateOneConfiguration(datasets, configuration);
   }
@@ -775,7 +777,7 @@ int main(int argc, char** argv) {
   std::vector<Configuration> configurations;
   // Every model with each split, at the paper's threshold and the default's.
   for (SensedSpaceModel m : {SensedSpaceModel::Points, SensedSpaceModel::FreeSpace, SensedSpaceModel::Visibility})
-    for (double threshold : {1.0, ObservationGrouping<pcl::PointXYZ>::kDefaultNcutThreshold})
+    for (double threshold : {GroupingParameters::paper().ncut_threshold, GroupingParameters{}.ncut_threshold})
       for (SplitCriterion s : {SplitCriterion::Mean, SplitCriterion::BestNcut}) {
         Configuration c = configuration;
         c.model = m;
@@ -788,10 +790,10 @@ int main(int argc, char** argv) {
       }
   // The default without the boundary refinement, to show what it changes.
   Configuration unrefined = configuration;
-  const ObservationGrouping<pcl::PointXYZ> defaults;
-  unrefined.model = defaults.getSensedSpaceModel();
-  unrefined.split = defaults.getSplitCriterion();
-  unrefined.ncut_threshold = defaults.getNcutThreshold();
+  const GroupingParameters defaults;
+  unrefined.model = defaults.model;
+  unrefined.split = defaults.split;
+  unrefined.ncut_threshold = defaults.ncut_threshold;
   unrefined.boundary_passes = 0;
   configurations.push_back(unrefined);
   const std::string report = page(datasets, configurations, generation_seconds);

@@ -71,12 +71,15 @@ int main(int argc, char** argv) {
     const auto points = obsgroup::sim::scanToPoints(plan.scan(pose, laser, k), laser);
     grouping.addObservation(obsgroup::sim::toCloud<pcl::PointXYZ>(points), obsgroup::pose2D(pose.x, pose.y, pose.yaw));
   }
-  grouping.setMatchDistance(delta);
-  grouping.setDiagonalWeight(diagonal);
+  // The paper's method (the points model of Fig. 5), with the options given.
+  obsgroup::GroupingParameters params = obsgroup::GroupingParameters::paper();
+  params.match_distance = delta;
+  params.diagonal_weight = diagonal;
   try {
-    grouping.setSplitCriterion(obsgroup::splitCriterionFromString(split));
+    params.split = obsgroup::splitCriterionFromString(split);
+    grouping.setParameters(params);
   } catch (const std::exception& e) {
-    std::cerr << "error: option --split: " << e.what() << "\n";
+    std::cerr << "error: " << e.what() << "\n";
     return 2;
   }
 

@@ -2,7 +2,10 @@
 // the pose), ObservationGrouping configured, groups out, and each group's
 // clouds merged into one local cloud with plain PCL calls.
 //
-//   pcl_grouping [--delta METRES] [--out FOLDER] file1.pcd file2.pcd ...
+//   pcl_grouping [--paper [--delta METRES]] [--out FOLDER] file1.pcd file2.pcd ...
+//
+// The defaults group by visibility (obsgroup::GroupingParameters); --paper
+// uses the paper's method, whose points model matches within --delta.
 //
 // Example: pcl_grouping data/real/localization_demo/pcd/*.pcd
 
@@ -15,23 +18,27 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 int main(int argc, char** argv) {
-  double delta = 0.1;
+  bool paper = false;
+  std::optional<double> delta;
   std::string out_folder;
   std::vector<std::string> files;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
-    if (arg == "--delta" && a + 1 < argc) delta = std::atof(argv[++a]);
+    if (arg == "--paper") paper = true;
+    else if (arg == "--delta" && a + 1 < argc) delta = std::atof(argv[++a]);
     else if (arg == "--out" && a + 1 < argc) out_folder = argv[++a];
     else files.push_back(arg);
   }
-  if (files.empty() || !(delta > 0)) {
-    std::cerr << "usage: " << argv[0] << " [--delta METRES] [--out FOLDER] file1.pcd file2.pcd ...\n";
+  if (files.empty() || (delta && !paper)) {
+    std::cerr << "usage: " << argv[0] << " [--paper [--delta METRES]] [--out FOLDER] file1.pcd file2.pcd ...\n";
     return 2;
   }
 
@@ -49,9 +56,17 @@ int main(int argc, char** argv) {
   }
 
   // 2. Configure and compute.
-  grouping.setMatchDistance(delta);
-  grouping.setNcutThreshold(1.0);
-  grouping.setSplitCriterion(obsgroup::SplitCriterion::Mean);
+  obsgroup::GroupingParameters params;  // the defaults
+  if (paper) {
+    params = obsgroup::GroupingParameters::paper();
+    params.match_distance = delta.value_or(params.match_distance);
+  }
+  try {
+    grouping.setParameters(params);  // checks every setting
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
   const obsgroup::Partition partition = grouping.compute();
 
   // 3. Groups out, each merged in the frame of its first observation.

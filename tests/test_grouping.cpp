@@ -5,6 +5,10 @@
 #include <obsgroup/online_grouping.h>
 
 #include <gtest/gtest.h>
+#include <pcl/search/kdtree.h>
+
+#include <cmath>
+#include <string>
 
 using namespace obsgroup;
 
@@ -97,23 +101,149 @@ TEST(ObservationGrouping, RejectsNullCloudsNamingTheirIndex) {
   EXPECT_EQ(g.getObservations().size(), 1u);
 }
 
-TEST(ObservationGrouping, PartitionOptionsSetLaterKeepTheThreadsAndTheInterruptFlag) {
+TEST(GroupingParameters, TheDefaultsAndThePaperPresetAreWrittenOnceAndUsedByEveryLayer) {
+  const GroupingParameters defaults;
+  EXPECT_EQ(defaults.model, SensedSpaceModel::Visibility);
+  EXPECT_EQ(defaults.split, SplitCriterion::BestNcut);
+  EXPECT_DOUBLE_EQ(defaults.ncut_threshold, 0.7);
+  EXPECT_EQ(defaults.boundary_passes, 3);
+  EXPECT_NO_THROW(defaults.check());
+  EXPECT_TRUE(ObservationGrouping<pcl::PointXYZ>().getParameters() == defaults);
+  EXPECT_TRUE(OnlineGrouping<pcl::PointXYZ>().getParameters() == defaults);
+
+  // The paper's: the points model and PartitionOptions' defaults (sec. II).
+  const GroupingParameters paper = GroupingParameters::paper();
+  const PartitionOptions papers_partition;
+  EXPECT_EQ(paper.model, SensedSpaceModel::Points);
+  EXPECT_EQ(paper.split, SplitCriterion::Mean);
+  EXPECT_EQ(paper.ncut_threshold, 1.0);
+  EXPECT_EQ(paper.boundary_passes, 0);
+  EXPECT_EQ(paper.partitionOptions().split, papers_partition.split);
+  EXPECT_EQ(paper.partitionOptions().ncut_threshold, papers_partition.ncut_threshold);
+  EXPECT_EQ(paper.partitionOptions().boundary_passes, papers_partition.boundary_passes);
+  EXPECT_NO_THROW(paper.check());
+  ObservationGrouping<pcl::PointXYZ> batch;
+  batch.setMatchDistance(0.3);  // usePaperMethod keeps delta, as the command's --paper does
+  batch.usePaperMethod();
+  GroupingParameters paper_with_delta = paper;
+  paper_with_delta.match_distance = 0.3;
+  EXPECT_TRUE(batch.getParameters() == paper_with_delta);
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.usePaperMethod();
+  EXPECT_TRUE(online.getParameters() == paper);
+}
+
+TEST(GroupingParameters, ASettingTheModelDoesNotUseIsRefusedNamingIt) {
+  const auto refused = [](const GroupingParameters& params, const std::string& words) {
+    try {
+      params.check();
+      ADD_FAILURE() << "accepted; expected: " << words;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    EXPECT_THROW(grouping.setParameters(params), std::invalid_argument);
+    EXPECT_TRUE(grouping.getParameters() == GroupingParameters{});  // nothing changed
+    OnlineGrouping<pcl::PointXYZ> online;
+    EXPECT_THROW(online.setParameters(params), std::invalid_argument);
+  };
+  GroupingParameters p;
+  p.match_distance = 0.2;  // delta under the visibility model
+  refused(p, "match_distance (delta) applies to the points model, not visibility");
+  p = GroupingParameters{};
+  p.neighbour_search = NeighbourSearch::PclSearch;
+  refused(p, "neighbour_search applies to the points model");
+  p = GroupingParameters::paper();
+  p.regions.cell_size = 0.1;
+  refused(p, "regions.cell_size applies to the free-space and visibility models, not points");
+  p = GroupingParameters{};
+  p.model = SensedSpaceModel::FreeSpace;
+  p.regions.clearance = 0.5;
+  refused(p, "regions.clearance applies to the visibility model only");
+  // ...and out of range.
+  p = GroupingParameters{};
+  p.regions.cell_size = 0.0;
+  refused(p, "cell size must be finite and > 0");
+  p = GroupingParameters::paper();
+  p.match_distance = -1;
+  refused(p, "match_distance (delta) must be finite and > 0");
+  p = GroupingParameters{};
+  p.ncut_threshold = std::nan("");
+  refused(p, "ncut_threshold must be finite");
+  p = GroupingParameters{};
+  p.min_group_size = 0;
+  refused(p, "min_group_size must be >= 1");
+  p = GroupingParameters{};
+  p.boundary_passes = -1;
+  refused(p, "boundary_passes must be >= 0");
+  p = GroupingParameters{};
+  p.threads = -2;
+  refused(p, "threads must be >= 0");
+}
+
+TEST(GroupingParameters, OneSetterAtATimeIsCheckedWhenTheGroupingRuns) {
+  const auto obs = test::simulate<pcl::PointXYZ>(sim::threeRooms(), sim::threeRoomsPoses(2));
+  ObservationGrouping<pcl::PointXYZ> batch;
+  for (const auto& o : obs) batch.addObservation(o.cloud, o.pose);
+  batch.setMatchDistance(0.2);  // silently ignored before: the default model has no delta
+  EXPECT_THROW(batch.compute(), std::invalid_argument);
+  batch.setSensedSpaceModel(SensedSpaceModel::Points);  // in any order: now delta applies
+  EXPECT_NO_THROW(batch.compute());
+  batch.setSensedSpaceModel(SensedSpaceModel::Visibility);
+  batch.setMatchDistance(GroupingParameters{}.match_distance);
+  batch.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
+  EXPECT_THROW(batch.compute(), std::invalid_argument);  // a search object is the points model's
+
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setMatchDistance(0.2);
+  EXPECT_THROW(online.insert(obs[0].cloud, obs[0].pose), std::invalid_argument);
+  EXPECT_TRUE(online.getIds().empty());
+  online.setSensedSpaceModel(SensedSpaceModel::Points);
+  EXPECT_EQ(online.insert(obs[0].cloud, obs[0].pose), 0);
+}
+
+TEST(GroupingParameters, TheThreadsAndTheInterruptFlagReachEveryStage) {
   ObservationGrouping<pcl::PointXYZ> g;
   InterruptFlag flag{false};
-  g.setNumberOfThreads(1);
   g.setInterruptFlag(&flag);
-  PartitionOptions options;
-  options.ncut_threshold = 0.5;
-  options.threads = 7;  // stored once, by setNumberOfThreads: ignored here
-  g.setPartitionOptions(options);
-  EXPECT_EQ(g.getPartitionOptions().threads, 1);
-  EXPECT_EQ(g.getPartitionOptions().interrupt, &flag);
-  EXPECT_EQ(g.getNumberOfThreads(), 1);
-  EXPECT_EQ(g.getNcutThreshold(), 0.5);
-  // Set after the options, the threads reach both stages.
-  g.setNumberOfThreads(2);
+  GroupingParameters params;
+  params.threads = 2;
+  params.ncut_threshold = 0.5;
+  g.setParameters(params);
   EXPECT_EQ(g.getPartitionOptions().threads, 2);
+  EXPECT_EQ(g.getPartitionOptions().interrupt, &flag);
+  EXPECT_EQ(g.getPartitionOptions().ncut_threshold, 0.5);
   EXPECT_EQ(g.getSensedSpaceOverlap().getNumberOfThreads(), 2);
+  EXPECT_EQ(g.getSensedSpaceOverlap().getInterruptFlag(), &flag);
+  g.setNumberOfThreads(1);
+  EXPECT_EQ(g.getPartitionOptions().threads, 1);
+  EXPECT_EQ(g.getParameters().threads, 1);
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setInterruptFlag(&flag);
+  online.setParameters(params);
+  EXPECT_EQ(online.getPartitionOptions().threads, 2);
+  EXPECT_EQ(online.getPartitionOptions().interrupt, &flag);
+  EXPECT_TRUE(online.getPartitionOptions().eigen.elimination_rank.empty());
+}
+
+TEST(GroupingParameters, TheOnlineGroupingGivesTheBatchsGroupsForTheSameParameters) {
+  const auto obs = test::simulate<pcl::PointXYZ>(sim::threeRooms(), sim::threeRoomsPoses(3));
+  GroupingParameters params;
+  params.regions.cell_size = 0.1;
+  params.ncut_threshold = 0.8;
+  params.boundary_passes = 1;
+  ObservationGrouping<pcl::PointXYZ> batch;
+  batch.setParameters(params);
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setParameters(params);
+  for (const auto& o : obs) {
+    batch.addObservation(o.cloud, o.pose);
+    online.insert(o.cloud, o.pose);
+  }
+  const Partition expected = batch.compute();
+  online.update();
+  EXPECT_EQ(online.getPartition().groups, expected.groups);
+  EXPECT_GT(expected.groups.size(), 1u);
 }
 
 // Every setting reads back as it was set.
@@ -130,6 +260,12 @@ TEST(ObservationGrouping, EverySetterHasItsGetter) {
   online.setMinGroupSize(3);
   online.setMaxDepth(5);
   online.setInterruptFlag(&flag);
+  online.setEigenSolver(EigenSolver::Dense);
+  online.setDiagonalWeight(0.5);
+  online.setVoxelLeafSize(0.05);
+  EXPECT_EQ(online.getEigenSolver(), EigenSolver::Dense);
+  EXPECT_EQ(online.getDiagonalWeight(), 0.5);
+  EXPECT_EQ(online.getVoxelLeafSize(), 0.05);
   EXPECT_EQ(online.getNcutThreshold(), 0.4);
   EXPECT_EQ(online.getSplitCriterion(), SplitCriterion::Mean);
   EXPECT_EQ(online.getMinGroupSize(), 3);

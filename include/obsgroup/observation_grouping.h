@@ -5,6 +5,7 @@
 
 #include "obsgroup/graph/observation_graph.h"
 #include "obsgroup/cloud/observation.h"
+#include "obsgroup/grouping_parameters.h"
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 
@@ -29,7 +30,7 @@ struct GroupingTimings {
 /// \code
 ///   obsgroup::ObservationGrouping<pcl::PointXYZ> grouping;
 ///   for (const auto& [cloud, pose] : scans) grouping.addObservation(cloud, pose);
-///   grouping.setSensedSpaceModel(obsgroup::SensedSpaceModel::Visibility);  // the default
+///   grouping.setParameters(obsgroup::GroupingParameters::paper());  // or keep the defaults
 ///   const obsgroup::Partition partition = grouping.compute();
 /// \endcode
 template <typename PointT>
@@ -41,31 +42,20 @@ class ObservationGrouping {
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
   using SearchMethodPtr = typename SensedSpaceOverlap<PointT>::SearchMethodPtr;
 
-  /// The defaults measure best across 2D lasers (360 and 180 degrees) and
-  /// depth cameras with drifted poses (docs/grouping.md): the visibility
-  /// model with the best-Ncut split. usePaperMethod() gives the paper's.
-  ObservationGrouping() {
-    overlap_.setSensedSpaceModel(SensedSpaceModel::Visibility);
-    options_.split = SplitCriterion::BestNcut;
-    options_.ncut_threshold = kDefaultNcutThreshold;
-    options_.boundary_passes = kDefaultBoundaryPasses;
+  /// The settings of the method, all at once (checked here: throws
+  /// std::invalid_argument as GroupingParameters::check()). The defaults are
+  /// GroupingParameters'; the setters below change one setting each, and
+  /// compute() checks them together.
+  void setParameters(const GroupingParameters& params) {
+    params.check();
+    params_ = params;
   }
-
-  /// The Ncut threshold of the defaults: the paper's 1 splits any group whose
-  /// overlap is not uniform (see docs/method.md); 0.7 keeps rooms whole.
-  static constexpr double kDefaultNcutThreshold = 0.7;
-  /// Sweeps of the boundary refinement of the defaults (PartitionOptions::
-  /// boundary_passes): doorway scans join the room their overlap says.
-  static constexpr int kDefaultBoundaryPasses = 3;
+  const GroupingParameters& getParameters() const { return params_; }
 
   /// The paper's method exactly: the points model of eq. (16)-(18), the mean
-  /// split of sec. II-A and the Ncut threshold 1 of sec. II-B (delta as set).
-  void usePaperMethod() {
-    overlap_.setSensedSpaceModel(SensedSpaceModel::Points);
-    options_.split = SplitCriterion::Mean;
-    options_.ncut_threshold = 1.0;
-    options_.boundary_passes = 0;
-  }
+  /// split of sec. II-A and the Ncut threshold 1 of sec. II-B (the other
+  /// settings, delta among them, as set). See GroupingParameters::paper().
+  void usePaperMethod() { params_.usePaperMethod(); }
 
   /// Adds an observation: points in the sensor frame and the sensor's pose.
   void addObservation(const PointCloudConstPtr& cloud, const Eigen::Isometry3d& pose);
@@ -76,57 +66,55 @@ class ObservationGrouping {
   /// Removes all observations and results.
   void clear();
 
-  // --- sensed-space overlap (sec. IV-A) ---
-  void setSensedSpaceModel(SensedSpaceModel model) { overlap_.setSensedSpaceModel(model); }
-  SensedSpaceModel getSensedSpaceModel() const { return overlap_.getSensedSpaceModel(); }
-  void setRegionParameters(const RegionParameters& params) { overlap_.setRegionParameters(params); }
-  const RegionParameters& getRegionParameters() const { return overlap_.getRegionParameters(); }
-  void setMatchDistance(double delta) { overlap_.setMatchDistance(delta); }
-  double getMatchDistance() const { return overlap_.getMatchDistance(); }
-  void setVoxelLeafSize(double leaf) { overlap_.setVoxelLeafSize(leaf); }
-  double getVoxelLeafSize() const { return overlap_.getVoxelLeafSize(); }
-  void setNeighbourSearch(NeighbourSearch method) { overlap_.setNeighbourSearch(method); }
-  NeighbourSearch getNeighbourSearch() const { return overlap_.getNeighbourSearch(); }
-  void setSearchMethod(const SearchMethodPtr& search) { overlap_.setSearchMethod(search); }
-  SearchMethodPtr getSearchMethod() const { return overlap_.getSearchMethod(); }
+  // --- sensed-space overlap (sec. IV-A); GroupingParameters says which model uses what ---
+  void setSensedSpaceModel(SensedSpaceModel model) { params_.model = model; }
+  SensedSpaceModel getSensedSpaceModel() const { return params_.model; }
+  void setRegionParameters(const RegionParameters& params) { params_.regions = params; }
+  const RegionParameters& getRegionParameters() const { return params_.regions; }
+  void setMatchDistance(double delta) { params_.match_distance = delta; }
+  double getMatchDistance() const { return params_.match_distance; }
+  void setVoxelLeafSize(double leaf) { params_.voxel_leaf = leaf; }
+  double getVoxelLeafSize() const { return params_.voxel_leaf; }
+  void setNeighbourSearch(NeighbourSearch method) { params_.neighbour_search = method; }
+  NeighbourSearch getNeighbourSearch() const { return params_.neighbour_search; }
+  /// Points model: a PCL search object, as PCL algorithms take one (see
+  /// SensedSpaceOverlap::setSearchMethod). Selects NeighbourSearch::PclSearch.
+  void setSearchMethod(const SearchMethodPtr& search) {
+    search_ = search;
+    params_.neighbour_search = NeighbourSearch::PclSearch;
+  }
+  SearchMethodPtr getSearchMethod() const { return search_; }
   /// Threads for the overlap and the partition; the result does not depend on it.
-  /// Stored once, in the overlap stage; the partition is given the same.
-  void setNumberOfThreads(int threads) { overlap_.setNumberOfThreads(threads); }
-  int getNumberOfThreads() const { return overlap_.getNumberOfThreads(); }
-  void setProgressCallback(ProgressCallback callback) { overlap_.setProgressCallback(std::move(callback)); }
-  const ProgressCallback& getProgressCallback() const { return overlap_.getProgressCallback(); }
+  void setNumberOfThreads(int threads) { params_.threads = threads; }
+  int getNumberOfThreads() const { return params_.threads; }
+  void setProgressCallback(ProgressCallback callback) { progress_ = std::move(callback); }
+  const ProgressCallback& getProgressCallback() const { return progress_; }
   /// A flag polled during compute() (see interrupt.h); when it is set,
   /// compute() stops and throws Interrupted. Not owned.
-  void setInterruptFlag(const InterruptFlag* flag) { overlap_.setInterruptFlag(flag); }
-  const InterruptFlag* getInterruptFlag() const { return overlap_.getInterruptFlag(); }
+  void setInterruptFlag(const InterruptFlag* flag) { interrupt_ = flag; }
+  const InterruptFlag* getInterruptFlag() const { return interrupt_; }
 
   // --- graph and partition (sec. II, III) ---
   /// W_ii; 0 by default instead of the paper's 1 (see kDefaultDiagonalWeight).
-  void setDiagonalWeight(double value) { diagonal_ = value; }
-  double getDiagonalWeight() const { return diagonal_; }
-  void setBoundaryPasses(int passes) { options_.boundary_passes = passes; }
-  int getBoundaryPasses() const { return options_.boundary_passes; }
-  void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; }
-  double getNcutThreshold() const { return options_.ncut_threshold; }
-  void setSplitCriterion(SplitCriterion criterion) { options_.split = criterion; }
-  SplitCriterion getSplitCriterion() const { return options_.split; }
-  void setMinGroupSize(int size) { options_.min_group_size = size; }
-  int getMinGroupSize() const { return options_.min_group_size; }
-  void setMaxDepth(int depth) { options_.max_depth = depth; }
-  int getMaxDepth() const { return options_.max_depth; }
-  void setEigenSolver(EigenSolver solver) { options_.eigen.solver = solver; }
-  EigenSolver getEigenSolver() const { return options_.eigen.solver; }
-  /// All partition options at once. The thread count and the interrupt flag
-  /// are the ones setNumberOfThreads and setInterruptFlag gave (for the
-  /// overlap and the partition alike): those of `options` are ignored, so
-  /// that setting the options later does not undo them.
-  void setPartitionOptions(const PartitionOptions& options) { options_ = options; }
-  /// The options compute() partitions with: those set, with this object's
-  /// thread count and interrupt flag.
+  void setDiagonalWeight(double value) { params_.diagonal_weight = value; }
+  double getDiagonalWeight() const { return params_.diagonal_weight; }
+  void setBoundaryPasses(int passes) { params_.boundary_passes = passes; }
+  int getBoundaryPasses() const { return params_.boundary_passes; }
+  void setNcutThreshold(double threshold) { params_.ncut_threshold = threshold; }
+  double getNcutThreshold() const { return params_.ncut_threshold; }
+  void setSplitCriterion(SplitCriterion criterion) { params_.split = criterion; }
+  SplitCriterion getSplitCriterion() const { return params_.split; }
+  void setMinGroupSize(int size) { params_.min_group_size = size; }
+  int getMinGroupSize() const { return params_.min_group_size; }
+  void setMaxDepth(int depth) { params_.max_depth = depth; }
+  int getMaxDepth() const { return params_.max_depth; }
+  void setEigenSolver(EigenSolver solver) { params_.eigen_solver = solver; }
+  EigenSolver getEigenSolver() const { return params_.eigen_solver; }
+  /// The options compute() partitions with (GroupingParameters::
+  /// partitionOptions() and this object's interrupt flag).
   PartitionOptions getPartitionOptions() const {
-    PartitionOptions options = options_;
-    options.threads = overlap_.getNumberOfThreads();
-    options.interrupt = overlap_.getInterruptFlag();
+    PartitionOptions options = params_.partitionOptions();
+    options.interrupt = interrupt_;
     return options;
   }
 
@@ -140,7 +128,7 @@ class ObservationGrouping {
   const OverlapResult& getOverlap() const { return overlap_result_; }
   /// The overlap stage as configured (model, voxel leaf, regions, threads),
   /// e.g. to compute the observations' regions for a picture.
-  const SensedSpaceOverlap<PointT>& getSensedSpaceOverlap() const { return overlap_; }
+  SensedSpaceOverlap<PointT> getSensedSpaceOverlap() const;
   /// Keep the observations' points in the common frame, as the overlap saw
   /// them (filtered, at the input poses), after compute(): off by default,
   /// as they are as large as the clouds.
@@ -157,9 +145,10 @@ class ObservationGrouping {
 
  private:
   std::vector<Observation<PointT>> observations_;
-  SensedSpaceOverlap<PointT> overlap_;
-  double diagonal_ = kDefaultDiagonalWeight;
-  PartitionOptions options_;
+  GroupingParameters params_;
+  SearchMethodPtr search_;
+  ProgressCallback progress_;
+  const InterruptFlag* interrupt_ = nullptr;
   OverlapResult overlap_result_;
   WeightMatrix W_;
   bool keep_world_points_ = false;

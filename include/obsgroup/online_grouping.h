@@ -5,9 +5,10 @@
 /// wants its local maps while it drives.
 
 #include "obsgroup/cloud/observation.h"
-#include "obsgroup/common/enum_names.h"
+#include "obsgroup/grouping_parameters.h"
 #include "obsgroup/observation_grouping.h"
 #include "obsgroup/overlap/incremental_overlap.h"
+#include "obsgroup/partition/group_tracking.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <map>
@@ -16,41 +17,6 @@
 #include <vector>
 
 namespace obsgroup {
-
-/// One change of the groups made by OnlineGrouping::update().
-struct GroupChange {
-  enum class Kind {
-    Created,  ///< A new group of observations that were in no group (new ones).
-    Grown,    ///< The group kept its id and gained observations.
-    Shrunk,   ///< The group kept its id and lost observations.
-    Changed,  ///< The group kept its id, gained some observations and lost others.
-    Split,    ///< `group`'s observations now lie in the groups `related` (one may still be `group`).
-    Merged,   ///< `group` now holds observations of the groups `related` (one may be `group` itself).
-    Removed   ///< The group is gone: its observations were removed.
-  };
-  Kind kind = Kind::Created;
-  int group = -1;
-  std::vector<int> related;
-  std::vector<int> members;  ///< The group's observations after the change (empty for Removed, Split).
-};
-
-inline constexpr EnumName<GroupChange::Kind> kGroupChangeNames[] = {
-    {GroupChange::Kind::Created, "created"}, {GroupChange::Kind::Grown, "grown"},
-    {GroupChange::Kind::Shrunk, "shrunk"},   {GroupChange::Kind::Changed, "changed"},
-    {GroupChange::Kind::Split, "split"},     {GroupChange::Kind::Merged, "merged"},
-    {GroupChange::Kind::Removed, "removed"}};
-inline std::string toString(GroupChange::Kind kind) { return nameOf(kGroupChangeNames, kind); }
-
-/// What one OnlineGrouping::update() did.
-struct GroupUpdate {
-  std::vector<GroupChange> changes;  ///< Split and Merged first, then the rest, each by group id.
-  /// True when the partition was computed exactly (equal to compute()); false
-  /// for a local update (OnlineGrouping::setExactInterval).
-  bool exact = true;
-  std::size_t observations_recomputed = 0;  ///< Observations whose overlaps were recomputed.
-  std::size_t split_nodes_reused = 0;       ///< Nodes of the split tree copied from the last update.
-  std::size_t split_nodes_computed = 0;     ///< Nodes solved anew by an exact update (0 for a local one).
-};
 
 /// Online grouping: insert(), updatePose() and remove() record the change;
 /// update() brings the groups up to date and says what changed.
@@ -78,12 +44,19 @@ class OnlineGrouping {
   using PointCloud = pcl::PointCloud<PointT>;
   using PointCloudConstPtr = typename PointCloud::ConstPtr;
 
-  /// ObservationGrouping's defaults (the visibility model, best-Ncut split,
-  /// threshold 0.7).
-  OnlineGrouping();
+  /// The defaults of GroupingParameters, as ObservationGrouping's.
+  OnlineGrouping() = default;
 
-  /// The paper's method exactly (ObservationGrouping::usePaperMethod).
-  void usePaperMethod();
+  /// The settings of the method, all at once (checked here: throws
+  /// std::invalid_argument as GroupingParameters::check()). Changing any but
+  /// the thread count recomputes everything at the next update().
+  /// GroupingParameters::neighbour_search is the batch's back-end only: the
+  /// online grouping has its own matcher, with the same W.
+  void setParameters(const GroupingParameters& params);
+  const GroupingParameters& getParameters() const { return params_; }
+
+  /// The paper's method exactly (GroupingParameters::usePaperMethod).
+  void usePaperMethod() { params_.usePaperMethod(); reconfigure(); }
 
   /// Adds an observation and returns its id (0, 1, 2, ... in insertion
   /// order, never reused). Throws InvalidObservation naming that id on a null
@@ -119,9 +92,9 @@ class OnlineGrouping {
   /// The observations present, in id order (node k of the partition is getIds()[k]).
   std::vector<Observation<PointT>> getObservations() const;
   /// The groups of the last update(): id -> member ids, ascending.
-  const std::map<int, std::vector<int>>& getGroups() const { return groups_; }
+  const std::map<int, std::vector<int>>& getGroups() const { return group_ids_.groups(); }
   /// The group of an observation after the last update() (-1: none yet).
-  int getGroupOf(int id) const;
+  int getGroupOf(int id) const { return group_ids_.groupOf(id); }
   /// The partition of the last update(), over getIds() positions, as
   /// ObservationGrouping::compute() returns it.
   const Partition& getPartition() const { return partition_; }
@@ -130,39 +103,39 @@ class OnlineGrouping {
   /// What the user should know about the last update() (as ObservationGrouping's).
   const std::vector<std::string>& getWarnings() const { return warnings_; }
 
-  // --- parameters: as ObservationGrouping's; changing one recomputes all at the next update() ---
-  void setSensedSpaceModel(SensedSpaceModel model) { config_.setSensedSpaceModel(model); reconfigure(); }
-  SensedSpaceModel getSensedSpaceModel() const { return config_.getSensedSpaceModel(); }
-  void setRegionParameters(const RegionParameters& params) { config_.setRegionParameters(params); reconfigure(); }
-  const RegionParameters& getRegionParameters() const { return config_.getRegionParameters(); }
-  void setMatchDistance(double delta) { config_.setMatchDistance(delta); reconfigure(); }
-  double getMatchDistance() const { return config_.getMatchDistance(); }
-  void setVoxelLeafSize(double leaf) { config_.setVoxelLeafSize(leaf); reconfigure(); }
-  double getVoxelLeafSize() const { return config_.getVoxelLeafSize(); }
-  void setDiagonalWeight(double value) { diagonal_ = value; reconfigure(); }
-  double getDiagonalWeight() const { return diagonal_; }
-  void setPartitionOptions(const PartitionOptions& options) { options_ = options; reconfigure(); }
-  /// The partition options (thread count and interrupt flag: this object's).
-  PartitionOptions getPartitionOptions() const;
-  void setNcutThreshold(double threshold) { options_.ncut_threshold = threshold; reconfigure(); }
-  double getNcutThreshold() const { return options_.ncut_threshold; }
-  void setSplitCriterion(SplitCriterion criterion) { options_.split = criterion; reconfigure(); }
-  SplitCriterion getSplitCriterion() const { return options_.split; }
-  void setMinGroupSize(int size) { options_.min_group_size = size; reconfigure(); }
-  int getMinGroupSize() const { return options_.min_group_size; }
-  void setMaxDepth(int depth) { options_.max_depth = depth; reconfigure(); }
-  int getMaxDepth() const { return options_.max_depth; }
+  // --- one setting at a time: as ObservationGrouping's; changing one recomputes all at the next update() ---
+  void setSensedSpaceModel(SensedSpaceModel model) { params_.model = model; reconfigure(); }
+  SensedSpaceModel getSensedSpaceModel() const { return params_.model; }
+  void setRegionParameters(const RegionParameters& params) { params_.regions = params; reconfigure(); }
+  const RegionParameters& getRegionParameters() const { return params_.regions; }
+  void setMatchDistance(double delta) { params_.match_distance = delta; reconfigure(); }
+  double getMatchDistance() const { return params_.match_distance; }
+  void setVoxelLeafSize(double leaf) { params_.voxel_leaf = leaf; reconfigure(); }
+  double getVoxelLeafSize() const { return params_.voxel_leaf; }
+  void setDiagonalWeight(double value) { params_.diagonal_weight = value; reconfigure(); }
+  double getDiagonalWeight() const { return params_.diagonal_weight; }
+  void setNcutThreshold(double threshold) { params_.ncut_threshold = threshold; reconfigure(); }
+  double getNcutThreshold() const { return params_.ncut_threshold; }
+  void setSplitCriterion(SplitCriterion criterion) { params_.split = criterion; reconfigure(); }
+  SplitCriterion getSplitCriterion() const { return params_.split; }
+  void setMinGroupSize(int size) { params_.min_group_size = size; reconfigure(); }
+  int getMinGroupSize() const { return params_.min_group_size; }
+  void setMaxDepth(int depth) { params_.max_depth = depth; reconfigure(); }
+  int getMaxDepth() const { return params_.max_depth; }
   /// Sweeps of the boundary refinement (PartitionOptions::boundary_passes).
-  void setBoundaryPasses(int passes) { options_.boundary_passes = passes; reconfigure(); }
-  int getBoundaryPasses() const { return options_.boundary_passes; }
+  void setBoundaryPasses(int passes) { params_.boundary_passes = passes; reconfigure(); }
+  int getBoundaryPasses() const { return params_.boundary_passes; }
+  void setEigenSolver(EigenSolver solver) { params_.eigen_solver = solver; reconfigure(); }
+  EigenSolver getEigenSolver() const { return params_.eigen_solver; }
   /// Threads for update(); the result does not depend on it.
-  void setNumberOfThreads(int threads) { config_.setNumberOfThreads(threads); }
-  int getNumberOfThreads() const { return config_.getNumberOfThreads(); }
-  void setInterruptFlag(const InterruptFlag* flag) { config_.setInterruptFlag(flag); }
-  const InterruptFlag* getInterruptFlag() const { return config_.getInterruptFlag(); }
-  /// Sets every parameter to `grouping`'s (model, regions, delta, voxel,
-  /// diagonal, partition options), e.g. those of a command line.
-  void setParametersFrom(const ObservationGrouping<PointT>& grouping);
+  void setNumberOfThreads(int threads) { params_.threads = threads; }
+  int getNumberOfThreads() const { return params_.threads; }
+  void setInterruptFlag(const InterruptFlag* flag) { interrupt_ = flag; }
+  const InterruptFlag* getInterruptFlag() const { return interrupt_; }
+  /// The options update() partitions with: GroupingParameters::
+  /// partitionOptions() with this object's interrupt flag; each node of the
+  /// split tree orders its own elimination (SplitCache).
+  PartitionOptions getPartitionOptions() const;
 
  private:
   struct Slot {
@@ -176,34 +149,25 @@ class OnlineGrouping {
     exact_once_ = false;
   }
   int firstPresent() const;
+  /// The batch's overlap stage with these settings: it filters and moves
+  /// each observation exactly as ObservationGrouping does.
+  SensedSpaceOverlap<PointT> overlapStage() const;
   std::vector<Eigen::Vector3f> worldPointsOf(int id, const Observation<PointT>& observation,
                                              const Eigen::Vector3d& origin) const;
   void recentreAll();
-  struct GroupMatch {
-    std::vector<std::map<int, int>> from_old;  // new group -> old id -> members it took
-    std::map<int, std::map<int, int>> to_new;  // old id -> new group -> members it gave
-    std::vector<int> new_id;                   // the id of each new group
-  };
-  GroupMatch matchGroups(const std::vector<std::vector<int>>& groups);
-  std::vector<GroupChange> changesOf(const std::vector<std::vector<int>>& groups, const GroupMatch& match) const;
-  void assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out);
   std::vector<std::vector<int>> partitionExactly(const std::vector<int>& ids, GroupUpdate& out);
-  std::vector<std::vector<int>> partitionLocally(const std::vector<int>& ids, const std::vector<int>& changed_slots);
   GroupUpdate run(bool force_exact);
 
   std::vector<Slot> slots_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();  // the first present observation's position
-  SensedSpaceOverlap<PointT> config_;                 // overlap parameters (and their checks)
-  double diagonal_ = kDefaultDiagonalWeight;
-  PartitionOptions options_;
+  GroupingParameters params_;
+  const InterruptFlag* interrupt_ = nullptr;
   std::unique_ptr<IncrementalOverlap> overlap_;
   bool reconfigure_ = true;
   SplitCache cache_;
   Partition partition_;
   WeightMatrix W_;
-  std::map<int, std::vector<int>> groups_;
-  std::vector<int> group_of_;  // by id
-  int next_group_id_ = 0;
+  StableGroupIds group_ids_;
   std::vector<std::string> warnings_;
   int exact_interval_ = 1;
   int changes_since_exact_ = 0;       // observations inserted or moved since the last exact update

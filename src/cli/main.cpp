@@ -40,6 +40,7 @@ void catchInterrupts() {
 using namespace obsgroup;
 using cli::choices;
 using cli::finiteNumber;
+using cli::number;
 using cli::oneOf;
 using cli::wholeNumber;
 
@@ -135,76 +136,79 @@ void addDepthOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
 
 /// The sensed-space model and the partition (the paper's sec. II-III).
 void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
-  command.add_option("--sso", args.sso,
+  command.add_option("--sso", args.method.model,
                      "sensed-space model: points (eq. 16-18, the paper's), free-space (cells the beams cross) or "
-                     "visibility (cells visible from the pose) (default: " + toString(args.sso) + ")")
+                     "visibility (cells visible from the pose) (default: " + toString(args.method.model) + ")")
       ->transform(oneOf(kSensedSpaceModelNames))
       ->option_text(choices(kSensedSpaceModelNames))
       ->group("Method");
+  const obsgroup::GroupingParameters paper = obsgroup::GroupingParameters::paper();
   command.add_flag("--paper", args.paper,
-                   "the paper's method exactly: --sso points --split mean --ncut-threshold 1 --boundary-passes 0 (delta as given)")
+                   "the paper's method exactly: --sso " + toString(paper.model) + " --split " + toString(paper.split) +
+                       " --ncut-threshold " + number(paper.ncut_threshold) + " --boundary-passes " +
+                       std::to_string(paper.boundary_passes) + " (delta as given)")
       ->group("Method");
-  command.add_option("--cell", args.region.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
+  command.add_option("--cell", args.method.regions.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--range", args.region.max_range, "free-space, visibility: how far from the sensor, metres")
+  command.add_option("--range", args.method.regions.max_range, "free-space, visibility: how far from the sensor, metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--clearance", args.region.clearance,
+  command.add_option("--clearance", args.method.regions.clearance,
                      "visibility: occupied cells nearer the pose than this do not block, metres")
       ->check(finiteNumber(0.0))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--min-observations", args.region.min_observations,
+  command.add_option("--min-observations", args.method.regions.min_observations,
                      "visibility: a cell is occupied when this many observations have a point in it (and no more "
                      "saw through it)")
       ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Method");
   command.add_option("--band", args.band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
-                                          "LOW HIGH metres (default: " + std::to_string(args.region.band_low) + " " +
-                                          std::to_string(args.region.band_high) + ")")
+                                          "LOW HIGH metres (default: " + std::to_string(args.method.regions.band_low) + " " +
+                                          std::to_string(args.method.regions.band_high) + ")")
       ->expected(2)
       ->check(finiteNumber(-std::numeric_limits<double>::max()))
       ->group("Method");
-  command.add_option("--delta", args.delta, "points: match distance of eq. (16), metres")
+  command.add_option("--delta", args.method.match_distance, "points: match distance of eq. (16), metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--voxel", args.voxel, "voxel downsampling leaf before matching, metres (0 = off)")
+  command.add_option("--voxel", args.method.voxel_leaf, "voxel downsampling leaf before matching, metres (0 = off)")
       ->check(finiteNumber(0.0))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--ncut-threshold", args.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
+  command.add_option("--ncut-threshold", args.method.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
       ->check(finiteNumber(0.0, false, 2.0))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--boundary-passes", args.boundary_passes,
+  command.add_option("--boundary-passes", args.method.boundary_passes,
                      "sweeps after the split tree moving each observation to the group it overlaps most on "
                      "average (0: none, the paper's)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--split", args.split,
+  command.add_option("--split", args.method.split,
                      "how the eigenvector is cut: best (smallest Ncut), mean (the paper's) or sign (default: " +
-                         toString(args.split) + ")")
+                         toString(args.method.split) + ")")
       ->transform(oneOf(kSplitCriterionNames))
       ->option_text(choices(kSplitCriterionNames))
       ->group("Method");
-  command.add_option("--min-group-size", args.min_group_size, "reject a bisection giving a smaller group")
+  command.add_option("--min-group-size", args.method.min_group_size, "reject a bisection giving a smaller group")
       ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--max-depth", args.max_depth, "do not bisect deeper than this (default: no limit)")
+  command.add_option("--max-depth", args.method.max_depth, "do not bisect deeper than this (default: no limit)")
       ->check(wholeNumber(0))
       ->group("Method");
 }
 
 /// Threads, refinement, local maps and the outputs.
 void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
-  command.add_option("--threads", args.threads, "threads (0 = all cores); results do not depend on it")
+  command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
       ->check(wholeNumber(0))
       ->capture_default_str();
   command.add_option("--refine", args.refine,
@@ -278,34 +282,37 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
   using obsgroup::SplitCriterion;
   if (partition.count("--pose-format") && !args.poses) return "--pose-format applies to a --poses file (PCD sequences)";
   if (args.paper) {
-    if (partition.count("--sso") && args.sso != SensedSpaceModel::Points)
-      return "--paper uses --sso points; drop one of them";
-    if (partition.count("--split") && args.split != SplitCriterion::Mean)
-      return "--paper uses --split mean; drop one of them";
-    if (partition.count("--ncut-threshold") && args.ncut_threshold != 1.0)
-      return "--paper uses --ncut-threshold 1; drop one of them";
-    args.sso = SensedSpaceModel::Points;
-    args.split = SplitCriterion::Mean;
-    if (partition.count("--boundary-passes") && args.boundary_passes != 0)
-      return "--paper uses --boundary-passes 0; drop one of them";
-    args.ncut_threshold = 1.0;
-    args.boundary_passes = 0;
+    const obsgroup::GroupingParameters paper = obsgroup::GroupingParameters::paper();
+    if (partition.count("--sso") && args.method.model != paper.model)
+      return "--paper uses --sso " + toString(paper.model) + "; drop one of them";
+    if (partition.count("--split") && args.method.split != paper.split)
+      return "--paper uses --split " + toString(paper.split) + "; drop one of them";
+    if (partition.count("--ncut-threshold") && args.method.ncut_threshold != paper.ncut_threshold)
+      return "--paper uses --ncut-threshold " + number(paper.ncut_threshold) + "; drop one of them";
+    if (partition.count("--boundary-passes") && args.method.boundary_passes != paper.boundary_passes)
+      return "--paper uses --boundary-passes " + std::to_string(paper.boundary_passes) + "; drop one of them";
+    args.method.usePaperMethod();
   }
   // Options of one model given with another are a mistake, not a no-op.
-  const bool points = args.sso == SensedSpaceModel::Points;
+  const bool points = args.method.model == SensedSpaceModel::Points;
   for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})
     if (points && partition.count(option))
       return std::string(option) + " applies to --sso free-space or visibility, not points";
   if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
-  if (args.sso == SensedSpaceModel::FreeSpace)
+  if (args.method.model == SensedSpaceModel::FreeSpace)
     for (const char* option : {"--clearance", "--min-observations", "--band"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
   if (!args.band.empty()) {
     if (!(args.band[0] < args.band[1]))
       return "--band: LOW must be below HIGH (got " + std::to_string(args.band[0]) + " " +
              std::to_string(args.band[1]) + ")";
-    args.region.band_low = args.band[0];
-    args.region.band_high = args.band[1];
+    args.method.regions.band_low = args.band[0];
+    args.method.regions.band_high = args.band[1];
+  }
+  try {
+    args.method.check();  // what the options' own checks cannot see, e.g. a range of too many cells
+  } catch (const std::invalid_argument& e) {
+    return std::string(e.what());
   }
   args.pictures = !args.no_pictures;
   return std::nullopt;

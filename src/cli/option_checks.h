@@ -16,14 +16,17 @@
 
 namespace obsgroup::cli {
 
+/// A number as a user wrote it: 1, 0.7, 1e-06.
+inline std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
 /// A finite number in [low, high]; `low_open` makes the lower bound strict.
 inline CLI::Validator finiteNumber(double low, bool low_open = false,
                                    double high = std::numeric_limits<double>::infinity()) {
-  auto bound = [](double v) {
-    std::ostringstream out;
-    out << v;
-    return out.str();
-  };
+  const auto bound = number;
   std::string range;
   if (std::isinf(high))
     range = std::string(low_open ? "> " : ">= ") + bound(low);

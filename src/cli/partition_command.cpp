@@ -129,16 +129,7 @@ std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& o
 template <typename PointT>
 void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& grouping) {
   grouping.setInterruptFlag(args.interrupt);
-  grouping.setSensedSpaceModel(args.sso);
-  grouping.setRegionParameters(args.region);
-  grouping.setMatchDistance(args.delta);
-  grouping.setVoxelLeafSize(args.voxel);
-  grouping.setNcutThreshold(args.ncut_threshold);
-  grouping.setSplitCriterion(args.split);
-  grouping.setBoundaryPasses(args.boundary_passes);
-  grouping.setMinGroupSize(args.min_group_size);
-  if (args.max_depth) grouping.setMaxDepth(*args.max_depth);
-  grouping.setNumberOfThreads(args.threads);
+  grouping.setParameters(args.method);
   grouping.setKeepWorldPoints(args.pictures);  // map.png draws them
 }
 
@@ -197,9 +188,9 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
   MapsOfRun<PointT> run;
   LocalMapBuilder<PointT> builder;
   builder.setRefinement(args.refine);
-  run.voxel = args.map_voxel.value_or(args.delta / 2);
+  run.voxel = args.map_voxel.value_or(args.method.match_distance / 2);
   builder.setVoxelLeafSize(run.voxel);
-  builder.setNumberOfThreads(args.threads);
+  builder.setNumberOfThreads(args.method.threads);
   builder.setInterruptFlag(args.interrupt);
   run.maps = builder.build(observations, partition, W);
   std::vector<LocalMapFrame> frames;
@@ -211,7 +202,7 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
     run.refinement += run.maps[g].refinement;
   }
   if (!run.refinement.warning().empty()) warn("refinement: " + run.refinement.warning());
-  run.topology = buildTopologicalMap(std::move(frames), W, posesOf(observations), args.threads);
+  run.topology = buildTopologicalMap(std::move(frames), W, posesOf(observations), args.method.threads);
   run.seconds = secondsSince(start);
   return run;
 }
@@ -225,7 +216,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   const WorldPoints& world = grouped.world();
   const Partition& partition = grouped.partition;
   ObservationRegions regions;
-  const bool tinted = args.sso != SensedSpaceModel::Points;
+  const bool tinted = args.method.model != SensedSpaceModel::Points;
   if (tinted) regions = grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, world);
   // Staged with the other results, so that they appear together or not at all.
   const render::PictureWriter staged = [&out](const std::string& name,
@@ -237,32 +228,33 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
                            tinted ? &regions : nullptr);
   render::writeWeightsPicture(staged, grouped.W, partition);
   render::writeFiedlerPicture(staged, partition);
-  render::writeLocalMapPictures(staged, maps.maps, args.threads, render::groupColours(maps.topology));
+  render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology));
 }
 
-/// The method's settings as partition.json records them.
-nlohmann::json methodParameters(const PartitionArgs& args, double diagonal, double map_voxel) {
+/// The settings the grouping ran with, as partition.json records them: only
+/// those its model uses.
+nlohmann::json methodParameters(const GroupingParameters& method, const PartitionArgs& args, double map_voxel) {
   nlohmann::json p;
-  p["sso"] = toString(args.sso);
-  if (args.sso == SensedSpaceModel::Points) {
-    p["delta"] = args.delta;
+  p["sso"] = toString(method.model);
+  if (method.model == SensedSpaceModel::Points) {
+    p["delta"] = method.match_distance;
+    p["neighbour_search"] = method.neighbour_search == NeighbourSearch::SharedGrid ? "shared_grid" : "pcl_search";
   } else {
-    p["cell"] = args.region.cell_size;
-    p["range"] = args.region.max_range;
-    if (args.sso == SensedSpaceModel::Visibility) {
-      p["clearance"] = args.region.clearance;
-      p["min_observations"] = args.region.min_observations;
-      p["band"] = {args.region.band_low, args.region.band_high};
+    p["cell"] = method.regions.cell_size;
+    p["range"] = method.regions.max_range;
+    if (method.model == SensedSpaceModel::Visibility) {
+      p["clearance"] = method.regions.clearance;
+      p["min_observations"] = method.regions.min_observations;
+      p["band"] = {method.regions.band_low, method.regions.band_high};
     }
   }
-  p["voxel"] = args.voxel;
-  p["ncut_threshold"] = args.ncut_threshold;
-  p["split"] = toString(args.split);
-  p["boundary_passes"] = args.boundary_passes;
-  p["min_group_size"] = args.min_group_size;
-  p["max_depth"] = args.max_depth ? nlohmann::json(*args.max_depth) : nlohmann::json();
-  p["diagonal"] = diagonal;
-  if (args.sso == SensedSpaceModel::Points) p["neighbour_search"] = "shared_grid";
+  p["voxel"] = method.voxel_leaf;
+  p["ncut_threshold"] = method.ncut_threshold;
+  p["split"] = toString(method.split);
+  p["boundary_passes"] = method.boundary_passes;
+  p["min_group_size"] = method.min_group_size;
+  p["max_depth"] = method.max_depth == GroupingParameters{}.max_depth ? nlohmann::json() : nlohmann::json(method.max_depth);
+  p["diagonal"] = method.diagonal_weight;
   p["map_voxel"] = map_voxel;
   p["refine"] = toString(args.refine);
   return p;
@@ -279,7 +271,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
                          const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
   const auto start = Clock::now();
   OutputTimes t;
-  t.map_points = io::writeLocalMaps(out, maps.maps, args.threads);
+  t.map_points = io::writeLocalMaps(out, maps.maps, args.method.threads);
   out.writeText("topology.json", io::topologyJson(maps.topology));
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
@@ -302,7 +294,7 @@ io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, con
   run.input = args.input;
   run.parameters = input.parameters;
   run.parameters["format"] = input.format;
-  run.parameters.update(methodParameters(args, grouped.grouping.getDiagonalWeight(), maps.voxel));
+  run.parameters.update(methodParameters(grouped.grouping.getParameters(), args, maps.voxel));
   run.parameters.update(grouped.parameters);
   // Objects keep their keys sorted: the grouping's own entries fall in place.
   run.statistics = grouped.statistics;
@@ -317,7 +309,7 @@ io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, con
                        {"local_maps", maps.seconds},
                        {"outputs", written.outputs_s},
                        {"pictures", written.pictures_s},
-                       {"threads", threadCount(args.threads)}});
+                       {"threads", threadCount(args.method.threads)}});
   return run;
 }
 
@@ -385,7 +377,7 @@ int runCarmen(const PartitionArgs& args) {
   options.laser = args.laser;
   options.field_of_view_deg = args.field_of_view_deg;
   options.max_range = args.max_range;
-  options.threads = args.threads;
+  options.threads = args.method.threads;
   options.skip_bad_lines = args.skip_bad_lines;
   options.require_timestamps = args.stream && args.stream->realtime;
   io::CarmenLog log = io::readCarmenLog(args.input, options);
@@ -571,7 +563,7 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
 }  // namespace
 
 int runPartition(const PartitionArgs& args) {
-  if (args.threads > 0) omp_set_num_threads(args.threads);  // every parallel stage, the writers' too
+  if (args.method.threads > 0) omp_set_num_threads(args.method.threads);  // every parallel stage, the writers' too
   const std::string format = detectFormat(args);
   checkOptionsFit(args, format);
   const bool stamped = format == "carmen" || format == "ros1" || format == "ros2";

@@ -7,9 +7,8 @@
 #include <obsgroup/io/depth_sequence.h>
 #include <obsgroup/io/pose_file.h>
 
+#include <obsgroup/grouping_parameters.h>
 #include <obsgroup/maps/local_map_builder.h>
-#include <obsgroup/overlap/sensed_regions.h>
-#include <obsgroup/spectral/spectral_bisection.h>
 
 #include <optional>
 #include <string>
@@ -50,23 +49,14 @@ struct PartitionArgs {
   std::optional<std::string> pose_topic;   ///< Odometry or PoseStamped topic
   std::optional<std::string> fixed_frame;  ///< /tf frame of the poses
   // the method
-  /// The defaults are the settings that measured best across lasers and
-  /// depth cameras with drifted poses (docs/grouping.md); `--paper` gives the
-  /// paper's (points, mean split).
-  SensedSpaceModel sso = SensedSpaceModel::Visibility;
-  RegionParameters region;  ///< free-space and visibility models
-  double delta = 0.1;
-  double voxel = 0.0;
-  double ncut_threshold = 0.7;  ///< ObservationGrouping::kDefaultNcutThreshold
-  SplitCriterion split = SplitCriterion::BestNcut;
-  int boundary_passes = 3;  ///< ObservationGrouping::kDefaultBoundaryPasses; --paper: 0
-  int min_group_size = 1;
-  std::optional<int> max_depth;
-  int threads = 0;
+  /// The defaults are GroupingParameters' (the settings that measured best
+  /// across lasers and depth cameras with drifted poses, docs/grouping.md);
+  /// `--paper` gives the paper's.
+  GroupingParameters method;
   std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
   Refinement refine = Refinement::None;
   bool paper = false;         ///< --paper: the preset, applied by the command line
-  std::vector<double> band;  ///< --band LOW HIGH as given (then in `region`)
+  std::vector<double> band;  ///< --band LOW HIGH as given (then in `method.regions`)
   // the run
   bool force = false;
   bool quiet = false;

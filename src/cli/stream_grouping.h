@@ -51,9 +51,9 @@ std::vector<std::size_t> filteredPointCounts(const SensedSpaceOverlap<PointT>& o
 template <typename PointT>
 void addWorldPoints(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
                     GroupingOutcome<PointT>& out) {
-  const SensedSpaceOverlap<PointT>& overlap = out.grouping.getSensedSpaceOverlap();
+  const SensedSpaceOverlap<PointT> overlap = out.grouping.getSensedSpaceOverlap();
   if (!args.pictures) {
-    out.points_per_observation = filteredPointCounts(overlap, observations, args.threads);
+    out.points_per_observation = filteredPointCounts(overlap, observations, args.method.threads);
     return;
   }
   out.stream_world = overlap.toWorld(observations);
@@ -125,8 +125,7 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
                         const std::vector<std::string>& labels, const std::vector<double>& stamps,
                         GroupingOutcome<PointT>& out) {
   OnlineGrouping<PointT> online;
-  online.setParametersFrom(out.grouping);
-  online.setNumberOfThreads(args.threads);
+  online.setParameters(out.grouping.getParameters());
   online.setInterruptFlag(args.interrupt);
   online.setExactInterval(args.stream->exact_every);
   ReplayClock clock(args.stream->realtime ? &stamps : nullptr, args.interrupt);

@@ -366,7 +366,7 @@ IncrementalOverlap::IncrementalOverlap(SensedSpaceModel model, double delta, con
     if (!(delta > 0.0) || !std::isfinite(delta))
       throw std::invalid_argument("match distance delta must be finite and > 0");
   } else {
-    checkParameters(params);
+    checkRegionParameters(params);
   }
 }
 IncrementalOverlap::~IncrementalOverlap() = default;

@@ -129,7 +129,7 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
                         const InterruptFlag* interrupt) {
   if (model == SensedSpaceModel::Points)
     throw std::invalid_argument("computeRegions: the points model has no regions (use SensedSpaceOverlap)");
-  checkParameters(params);
+  checkRegionParameters(params);
   const int n = world.size();
   if (static_cast<int>(sensor_origins.size()) != n)
     throw std::invalid_argument("computeRegions: one sensor origin per observation expected");
@@ -259,6 +259,19 @@ MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int thre
 }
 
 }  // namespace
+
+void checkRegionParameters(const RegionParameters& p) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(p.cell_size)) throw std::invalid_argument("region cell size must be finite and > 0");
+  if (!positive(p.max_range)) throw std::invalid_argument("region range must be finite and > 0");
+  // 2000 cells keeps a region's bitmap (4000^2 cells in 2D) within the dense marker.
+  if (p.max_range / p.cell_size > 2000)
+    throw std::invalid_argument("region range is more than 2000 cells: raise the cell size or lower the range");
+  if (!(std::isfinite(p.clearance) && p.clearance >= 0)) throw std::invalid_argument("clearance must be finite and >= 0");
+  if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
+  if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
+    throw std::invalid_argument("height band must be finite with low < high");
+}
 
 ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& world,
                                   const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,

@@ -30,22 +30,42 @@ void ObservationGrouping<PointT>::clear() {
 }
 
 template <typename PointT>
+SensedSpaceOverlap<PointT> ObservationGrouping<PointT>::getSensedSpaceOverlap() const {
+  SensedSpaceOverlap<PointT> overlap;
+  overlap.setSensedSpaceModel(params_.model);
+  overlap.setRegionParameters(params_.regions);
+  overlap.setMatchDistance(params_.match_distance);
+  overlap.setVoxelLeafSize(params_.voxel_leaf);
+  overlap.setNeighbourSearch(params_.neighbour_search);
+  if (search_ && params_.neighbour_search == NeighbourSearch::PclSearch) overlap.setSearchMethod(search_);
+  overlap.setNumberOfThreads(params_.threads);
+  overlap.setProgressCallback(progress_);
+  overlap.setInterruptFlag(interrupt_);
+  return overlap;
+}
+
+template <typename PointT>
 Partition ObservationGrouping<PointT>::compute() {
+  params_.check();
+  if (search_ && params_.neighbour_search == NeighbourSearch::PclSearch && params_.model != SensedSpaceModel::Points)
+    throw std::invalid_argument("grouping parameters: a search method applies to the points model, not " +
+                                toString(params_.model));
   using Clock = std::chrono::steady_clock;
   const auto seconds_since = [](Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
   };
   auto start = Clock::now();
+  const SensedSpaceOverlap<PointT> overlap = getSensedSpaceOverlap();
   world_ = WorldPoints{};
   if (keep_world_points_) {
-    world_ = overlap_.toWorld(observations_);
-    overlap_result_ = overlap_.compute(observations_, world_);
+    world_ = overlap.toWorld(observations_);
+    overlap_result_ = overlap.compute(observations_, world_);
   } else {
-    overlap_result_ = overlap_.compute(observations_);
+    overlap_result_ = overlap.compute(observations_);
   }
   timings_.overlap_s = seconds_since(start);
   start = Clock::now();
-  W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, diagonal_);
+  W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, params_.diagonal_weight);
   timings_.graph_s = seconds_since(start);
   start = Clock::now();
   Partition partition = recursivePartition(W_, getPartitionOptions());

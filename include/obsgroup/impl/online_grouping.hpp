@@ -6,47 +6,36 @@
 #include "obsgroup/overlap/impl/sensed_space_overlap.hpp"
 
 #include <algorithm>
-#include <set>
 #include <stdexcept>
 #include <string>
 
 namespace obsgroup {
 
 template <typename PointT>
-OnlineGrouping<PointT>::OnlineGrouping() {
-  const ObservationGrouping<PointT> defaults;
-  setParametersFrom(defaults);
-}
-
-template <typename PointT>
-void OnlineGrouping<PointT>::usePaperMethod() {
-  ObservationGrouping<PointT> paper;
-  paper.usePaperMethod();
-  setParametersFrom(paper);
-}
-
-template <typename PointT>
-void OnlineGrouping<PointT>::setParametersFrom(const ObservationGrouping<PointT>& grouping) {
-  const int threads = config_.getNumberOfThreads();
-  const InterruptFlag* interrupt = config_.getInterruptFlag();
-  config_.setSensedSpaceModel(grouping.getSensedSpaceModel());
-  config_.setRegionParameters(grouping.getRegionParameters());
-  config_.setMatchDistance(grouping.getMatchDistance());
-  config_.setVoxelLeafSize(grouping.getVoxelLeafSize());
-  config_.setNumberOfThreads(threads);
-  config_.setInterruptFlag(interrupt);
-  diagonal_ = grouping.getDiagonalWeight();
-  options_ = grouping.getPartitionOptions();
-  reconfigure();
+void OnlineGrouping<PointT>::setParameters(const GroupingParameters& params) {
+  params.check();
+  GroupingParameters same_but_threads = params;
+  same_but_threads.threads = params_.threads;
+  const bool changed = same_but_threads != params_;
+  params_ = params;
+  if (changed) reconfigure();
 }
 
 template <typename PointT>
 PartitionOptions OnlineGrouping<PointT>::getPartitionOptions() const {
-  PartitionOptions options = options_;
-  options.threads = config_.getNumberOfThreads();
-  options.interrupt = config_.getInterruptFlag();
-  options.eigen.elimination_rank.clear();  // each node orders itself (SplitCache)
+  PartitionOptions options = params_.partitionOptions();
+  options.interrupt = interrupt_;
   return options;
+}
+
+template <typename PointT>
+SensedSpaceOverlap<PointT> OnlineGrouping<PointT>::overlapStage() const {
+  SensedSpaceOverlap<PointT> overlap;
+  overlap.setSensedSpaceModel(params_.model);
+  overlap.setRegionParameters(params_.regions);
+  overlap.setMatchDistance(params_.match_distance);
+  overlap.setVoxelLeafSize(params_.voxel_leaf);
+  return overlap;
 }
 
 template <typename PointT>
@@ -62,7 +51,7 @@ std::vector<Eigen::Vector3f> OnlineGrouping<PointT>::worldPointsOf(int id, const
   if (!observation.cloud) throw InvalidObservation(id, "null cloud");
   if (!observation.pose.matrix().allFinite()) throw InvalidObservation(id, "pose is not finite");
   try {
-    return config_.observationToWorld(observation, origin);
+    return overlapStage().observationToWorld(observation, origin);
   } catch (const InvalidObservation&) {
     throw;
   } catch (const std::exception& e) {
@@ -86,7 +75,6 @@ int OnlineGrouping<PointT>::insert(const PointCloudConstPtr& cloud, const Eigen:
     throw InvalidObservation(id, e.what());
   }
   slots_.push_back({true, observation});
-  group_of_.push_back(-1);
   ++changes_since_exact_;
   origin_ = origin;
   overlap_->set(id, std::move(points), pose.translation() - origin);
@@ -151,10 +139,10 @@ void OnlineGrouping<PointT>::recentreAll() {
   const int first = firstPresent();
   const Eigen::Vector3d origin =
       first >= 0 ? Eigen::Vector3d(slots_[first].observation.pose.translation()) : Eigen::Vector3d::Zero();
-  auto fresh = std::make_unique<IncrementalOverlap>(config_.getSensedSpaceModel(), config_.getMatchDistance(),
-                                                    config_.getRegionParameters());
+  params_.check();
+  auto fresh = std::make_unique<IncrementalOverlap>(params_.model, params_.match_distance, params_.regions);
   std::vector<std::vector<Eigen::Vector3f>> points(slots_.size());
-  parallelFor(slots_.size(), config_.getNumberOfThreads(), 4, [&](std::size_t i) {
+  parallelFor(slots_.size(), params_.threads, 4, [&](std::size_t i) {
     if (slots_[i].present) points[i] = worldPointsOf(int(i), slots_[i].observation, origin);
   });
   for (int i = 0; i < int(slots_.size()); ++i) {
@@ -186,15 +174,24 @@ template <typename PointT>
 GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   if (reconfigure_ || !overlap_) recentreAll();
   GroupUpdate out;
-  const std::vector<int> changed_slots = overlap_->update(config_.getNumberOfThreads(), config_.getInterruptFlag());
+  const std::vector<int> changed_slots = overlap_->update(params_.threads, interrupt_);
   out.observations_recomputed = overlap_->recomputedLastUpdate();
   const std::vector<int> ids = overlap_->slots();
-  W_ = overlap_->weightMatrix(diagonal_);
+  W_ = overlap_->weightMatrix(params_.diagonal_weight);
   pending_.resize(slots_.size(), 0);
   for (int slot : changed_slots) pending_[slot] = 1;
   out.exact = force_exact || !exact_once_ || exact_interval_ <= 1 || changes_since_exact_ >= exact_interval_;
-  const std::vector<std::vector<int>> groups =
-      out.exact ? partitionExactly(ids, out) : partitionLocally(ids, changed_slots);
+  std::vector<std::vector<int>> groups;
+  if (out.exact) {
+    groups = partitionExactly(ids, out);
+  } else {
+    partition_ = partitionAroundChanges(W_, ids, changed_slots, group_ids_, getPartitionOptions());
+    for (const auto& group : partition_.groups) {
+      std::vector<int> members;
+      for (int k : group) members.push_back(ids[k]);
+      groups.push_back(std::move(members));
+    }
+  }
 
   warnings_.clear();
   for (int id : ids)
@@ -202,7 +199,7 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
       warnings_.push_back("observation " + std::to_string(id) +
                           " has no finite point: it overlaps nothing and forms a group of its own");
   warnings_.insert(warnings_.end(), partition_.warnings.begin(), partition_.warnings.end());
-  assignGroupIds(groups, out);
+  out.changes = group_ids_.assign(groups, slots_.size());
   return out;
 }
 
@@ -226,150 +223,6 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std
   return groups;
 }
 
-/// The groups holding a changed observation, the new observations and the
-/// groups next to them in W, re-partitioned on their own; the other groups
-/// kept (setExactInterval).
-template <typename PointT>
-std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionLocally(const std::vector<int>& ids,
-                                                                       const std::vector<int>& changed_slots) {
-  const auto position = [&ids](int id) { return int(std::lower_bound(ids.begin(), ids.end(), id) - ids.begin()); };
-  std::vector<char> in_region(ids.size(), 0);
-  std::set<int> region_groups;
-  for (int id : changed_slots)
-    if (group_of_[id] >= 0) region_groups.insert(group_of_[id]);
-  for (std::size_t k = 0; k < ids.size(); ++k)
-    if (group_of_[ids[k]] < 0) in_region[k] = 1;
-  for (int g : region_groups)
-    for (int id : groups_.at(g))
-      if (contains(id)) in_region[position(id)] = 1;
-  // ...and the groups next to them.
-  std::set<int> next_to;
-  for (std::size_t k = 0; k < ids.size(); ++k)
-    if (in_region[k])
-      for (WeightMatrix::InnerIterator it(W_, Eigen::Index(k)); it; ++it)
-        if (!in_region[it.row()] && group_of_[ids[it.row()]] >= 0) next_to.insert(group_of_[ids[it.row()]]);
-  for (int g : next_to)
-    for (int id : groups_.at(g))
-      if (contains(id)) in_region[position(id)] = 1;
-
-  std::vector<int> region;
-  for (std::size_t k = 0; k < ids.size(); ++k)
-    if (in_region[k]) region.push_back(int(k));
-  std::vector<std::vector<int>> groups;  // by position
-  if (!region.empty()) {
-    PartitionOptions options = getPartitionOptions();
-    options.keep_eigenvectors = false;
-    Partition local = recursivePartition(inducedSubgraph(W_, region), options);
-    for (auto& group : local.groups) {
-      for (int& k : group) k = region[k];
-      groups.push_back(std::move(group));
-    }
-    partition_.warnings = std::move(local.warnings);
-  } else {
-    partition_.warnings.clear();
-  }
-  for (const auto& [g, members] : groups_) {
-    std::vector<int> kept;
-    for (int id : members)
-      if (contains(id) && !in_region[position(id)]) kept.push_back(position(id));
-    if (!kept.empty()) groups.push_back(std::move(kept));
-  }
-  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
-  partition_.groups = groups;
-  partition_.splits.clear();
-  partition_.group_of.assign(ids.size(), -1);
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (int k : groups[g]) partition_.group_of[k] = int(g);
-  for (auto& group : groups)
-    for (int& k : group) k = ids[k];
-  return groups;
-}
-
-/// How the new groups take the old groups' members, and the id each new
-/// group gets: that of the old group it holds most of, when that old group's
-/// largest share went to it; a new id otherwise.
-template <typename PointT>
-typename OnlineGrouping<PointT>::GroupMatch OnlineGrouping<PointT>::matchGroups(
-    const std::vector<std::vector<int>>& groups) {
-  GroupMatch m;
-  m.from_old.resize(groups.size());
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (int id : groups[g])
-      if (group_of_[id] >= 0) {
-        ++m.from_old[g][group_of_[id]];
-        ++m.to_new[group_of_[id]][int(g)];
-      }
-  std::map<int, int> heir;  // old id -> the new group holding most of it (the first on a tie)
-  for (const auto& [old, counts] : m.to_new) {
-    int best = -1, best_count = 0;
-    for (const auto& [g, count] : counts)
-      if (count > best_count) best = g, best_count = count;
-    heir[old] = best;
-  }
-  m.new_id.assign(groups.size(), -1);
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    int best = -1, best_count = 0;
-    for (const auto& [old, count] : m.from_old[g])
-      if (heir[old] == int(g) && count > best_count) best = old, best_count = count;
-    m.new_id[g] = best >= 0 ? best : next_group_id_++;
-  }
-  return m;
-}
-
-/// The changes from groups_ to `groups`: splits, then merges, then the
-/// rest by group id.
-template <typename PointT>
-std::vector<GroupChange> OnlineGrouping<PointT>::changesOf(const std::vector<std::vector<int>>& groups,
-                                                           const GroupMatch& m) const {
-  std::vector<GroupChange> splits, merges, others;
-  for (const auto& [old, counts] : m.to_new)
-    if (counts.size() > 1) {
-      GroupChange c{GroupChange::Kind::Split, old, {}, {}};
-      for (const auto& [g, count] : counts) c.related.push_back(m.new_id[g]);
-      std::sort(c.related.begin(), c.related.end());
-      splits.push_back(std::move(c));
-    }
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const int id = m.new_id[g];
-    if (m.from_old[g].size() > 1) {
-      GroupChange c{GroupChange::Kind::Merged, id, {}, groups[g]};
-      for (const auto& [old, count] : m.from_old[g]) c.related.push_back(old);
-      merges.push_back(std::move(c));
-      continue;
-    }
-    const auto before = groups_.find(id);
-    if (before == groups_.end()) {
-      // Only new observations; a group split off an old one is reported as the split.
-      if (m.from_old[g].empty()) others.push_back({GroupChange::Kind::Created, id, {}, groups[g]});
-      continue;
-    }
-    if (before->second == groups[g]) continue;
-    const auto& old_members = before->second;
-    const bool grew = std::includes(groups[g].begin(), groups[g].end(), old_members.begin(), old_members.end());
-    const bool shrank = std::includes(old_members.begin(), old_members.end(), groups[g].begin(), groups[g].end());
-    if (shrank && m.to_new.at(id).size() > 1) continue;  // reported as the split
-    const auto kind = grew ? GroupChange::Kind::Grown : shrank ? GroupChange::Kind::Shrunk : GroupChange::Kind::Changed;
-    others.push_back({kind, id, {}, groups[g]});
-  }
-  for (const auto& [old, members] : groups_)
-    if (!m.to_new.count(old)) others.push_back({GroupChange::Kind::Removed, old, {}, {}});
-  std::sort(others.begin(), others.end(), [](const GroupChange& a, const GroupChange& b) { return a.group < b.group; });
-  splits.insert(splits.end(), merges.begin(), merges.end());
-  splits.insert(splits.end(), others.begin(), others.end());
-  return splits;
-}
-
-template <typename PointT>
-void OnlineGrouping<PointT>::assignGroupIds(const std::vector<std::vector<int>>& groups, GroupUpdate& out) {
-  const GroupMatch match = matchGroups(groups);
-  out.changes = changesOf(groups, match);
-  groups_.clear();
-  for (std::size_t g = 0; g < groups.size(); ++g) groups_[match.new_id[g]] = groups[g];
-  std::fill(group_of_.begin(), group_of_.end(), -1);
-  for (const auto& [id, members] : groups_)
-    for (int member : members) group_of_[member] = id;
-}
-
 template <typename PointT>
 std::vector<int> OnlineGrouping<PointT>::getIds() const {
   std::vector<int> ids;
@@ -390,11 +243,6 @@ std::vector<Observation<PointT>> OnlineGrouping<PointT>::getObservations() const
   for (const Slot& s : slots_)
     if (s.present) out.push_back(s.observation);
   return out;
-}
-
-template <typename PointT>
-int OnlineGrouping<PointT>::getGroupOf(int id) const {
-  return id >= 0 && id < int(group_of_.size()) ? group_of_[id] : -1;
 }
 
 }  // namespace obsgroup

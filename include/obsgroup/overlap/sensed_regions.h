@@ -35,6 +35,13 @@ enum class SensedSpaceModel {
   Visibility  ///< Cells visible all around the pose (own beams, then the shared occupancy grid).
 };
 
+/// Points model: how the points of one observation find a point of another
+/// within delta. Both give the same W (SensedSpaceOverlap).
+enum class NeighbourSearch {
+  SharedGrid,  ///< One grid over all observations' points (the default; see shared_grid_matcher.h).
+  PclSearch    ///< One pcl::search::Search per observation (kd-tree by default).
+};
+
 inline constexpr EnumName<SensedSpaceModel> kSensedSpaceModelNames[] = {
     {SensedSpaceModel::Points, "points"},
     {SensedSpaceModel::FreeSpace, "free-space"},
@@ -71,6 +78,15 @@ struct RegionParameters {
   double band_low = -0.7;
   double band_high = 0.8;
 };
+
+/// Throws std::invalid_argument naming the first parameter out of range.
+void checkRegionParameters(const RegionParameters& params);
+
+inline bool operator==(const RegionParameters& a, const RegionParameters& b) {
+  return a.cell_size == b.cell_size && a.max_range == b.max_range && a.clearance == b.clearance &&
+         a.min_observations == b.min_observations && a.band_low == b.band_low && a.band_high == b.band_high;
+}
+inline bool operator!=(const RegionParameters& a, const RegionParameters& b) { return !(a == b); }
 
 /// The cells of every observation's region: observation i owns
 /// cells[offsets[i], offsets[i+1]), ascending and distinct.

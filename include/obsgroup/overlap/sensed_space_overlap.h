@@ -16,12 +16,6 @@
 
 namespace obsgroup {
 
-/// How the points of one observation find a point of another within delta.
-enum class NeighbourSearch {
-  SharedGrid,  ///< One grid over all observations' points (the default; see shared_grid_matcher.h).
-  PclSearch    ///< One pcl::search::Search per observation (kd-tree by default).
-};
-
 /// Computes Pi (eq. 17) and Psi (eq. 18) for all pairs of observations.
 ///
 /// Each observation's points are cleaned of NaN/Inf, optionally downsampled
