@@ -596,6 +596,10 @@ TEST_F(Cli, UsageErrors) {
   EXPECT_EQ(run("partition " + input + out + " --paper --ncut-threshold 0.8").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --band 1 0").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --sso voxels").code, 2);
+  // A value each option accepts alone, refused together (GroupingParameters::check): a usage error too.
+  const Result cells = run("partition " + input + out + " --cell 0.001");
+  EXPECT_EQ(cells.code, 2);
+  EXPECT_NE(cells.err.find("more than 2000 cells"), std::string::npos) << cells.err;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
   const Result missing = run("partition " + (dir_ / "nothing.clf").string() + out);
   EXPECT_EQ(missing.code, 3);

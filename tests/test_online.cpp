@@ -338,3 +338,73 @@ TEST(OnlineGrouping, BadInputThrowsNamingTheIdAndChangesNothing) {
 
 }  // namespace
 }  // namespace obsgroup
+
+namespace obsgroup {
+
+// The group ids and changes alone, without a point type.
+TEST(StableGroupIds, IdsFollowTheLargestShareAndChangesAreReportedInOrder) {
+  StableGroupIds ids;
+  auto changes = ids.assign({{0, 1, 2}, {3, 4}}, 5);
+  ASSERT_EQ(changes.size(), 2u);
+  EXPECT_EQ(changes[0].kind, GroupChange::Kind::Created);
+  EXPECT_EQ(changes[0].group, 0);
+  EXPECT_EQ(changes[1].group, 1);
+  EXPECT_EQ(ids.groupOf(4), 1);
+  EXPECT_EQ(ids.groupOf(9), -1);  // no such observation yet
+
+  // Group 0 splits: {0, 1} keeps id 0 (its largest share), {2} gets a new id;
+  // group 1 grows by the new observation 5.
+  changes = ids.assign({{0, 1}, {2}, {3, 4, 5}}, 6);
+  ASSERT_EQ(changes.size(), 2u);
+  EXPECT_EQ(changes[0].kind, GroupChange::Kind::Split);
+  EXPECT_EQ(changes[0].group, 0);
+  EXPECT_EQ(changes[0].related, (std::vector<int>{0, 2}));
+  EXPECT_EQ(changes[1].kind, GroupChange::Kind::Grown);
+  EXPECT_EQ(changes[1].group, 1);
+  EXPECT_EQ(changes[1].members, (std::vector<int>{3, 4, 5}));
+  EXPECT_EQ(ids.groupOf(2), 2);
+
+  // Groups 0 and 2 merge into 0; group 1 loses observation 3 (removed).
+  changes = ids.assign({{0, 1, 2}, {4, 5}}, 6);
+  ASSERT_EQ(changes.size(), 2u);
+  EXPECT_EQ(changes[0].kind, GroupChange::Kind::Merged);
+  EXPECT_EQ(changes[0].group, 0);
+  EXPECT_EQ(changes[0].related, (std::vector<int>{0, 2}));
+  EXPECT_EQ(changes[1].kind, GroupChange::Kind::Shrunk);
+  EXPECT_EQ(changes[1].group, 1);
+  EXPECT_EQ(ids.groups().size(), 2u);
+
+  // All of group 1's observations leave.
+  changes = ids.assign({{0, 1, 2}}, 6);
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].kind, GroupChange::Kind::Removed);
+  EXPECT_EQ(changes[0].group, 1);
+  EXPECT_EQ(ids.groupOf(4), -1);
+}
+
+TEST(StableGroupIds, TheLocalUpdateRepartitionsOnlyTheGroupsAChangeReaches) {
+  // Three cliques of three, the first two joined weakly, the third apart.
+  std::vector<WeightedPair> pairs;
+  for (int c = 0; c < 3; ++c)
+    for (int a = 0; a < 3; ++a)
+      for (int b = a + 1; b < 3; ++b) pairs.push_back({3 * c + a, 3 * c + b, 1.0});
+  pairs.push_back({2, 3, 0.05});
+  const WeightMatrix W = buildWeightMatrix(9, pairs);
+  const std::vector<int> ids = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  StableGroupIds current;
+  current.assign({{0, 1, 2, 3, 4, 5}, {6, 7, 8}}, 9);  // as if the first two had been one group
+  PartitionOptions options;
+  options.ncut_threshold = 0.5;
+  const Partition p = partitionAroundChanges(W, ids, {0}, current, options);
+  // Observation 0's group is cut along the weak edge; the third clique, not
+  // next to it in W, is kept as it was.
+  EXPECT_EQ(p.groups, (std::vector<std::vector<int>>{{0, 1, 2}, {3, 4, 5}, {6, 7, 8}}));
+  EXPECT_TRUE(p.splits.empty());
+  EXPECT_EQ(p.group_of[4], 1);
+  // A change in the third clique leaves the first group alone even when it
+  // would now be cut.
+  const Partition q = partitionAroundChanges(W, ids, {7}, current, options);
+  EXPECT_EQ(q.groups, (std::vector<std::vector<int>>{{0, 1, 2, 3, 4, 5}, {6, 7, 8}}));
+}
+
+}  // namespace obsgroup
