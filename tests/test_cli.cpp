@@ -115,7 +115,56 @@ nlohmann::json expectPartitionSchema(const fs::path& out, std::size_t observatio
   return p;
 }
 
+/// places.json/.geojson, the label map and the occupancy map agree with
+/// partition.json and with each other.
+void expectPlaces(const fs::path& out, const nlohmann::json& partition) {
+  const nlohmann::json places = readJson(out / "places.json");
+  const auto& ids = partition.at("place_ids");
+  ASSERT_EQ(ids.size(), partition.at("groups").size());
+  ASSERT_EQ(places.at("places").size(), ids.size());
+  std::map<int, std::set<int>> neighbours;
+  for (std::size_t g = 0; g < ids.size(); ++g) {
+    const auto& place = places.at("places")[g];
+    EXPECT_EQ(place.at("id"), ids[g]);
+    EXPECT_EQ(place.at("members"), partition.at("groups")[g]);
+    EXPECT_GT(place.at("area_m2").get<double>(), 0.0);
+    EXPECT_EQ(place.at("bbox").size(), 4u);
+    for (const auto& ring : place.at("outline")) EXPECT_GE(ring.size(), 4u);
+    neighbours[place.at("id").get<int>()] = place.at("neighbours").get<std::set<int>>();
+  }
+  for (const auto& door : places.at("doors")) {
+    const int a = door.at("places")[0], b = door.at("places")[1];
+    EXPECT_TRUE(neighbours[a].count(b) && neighbours[b].count(a)) << door.dump();
+    EXPECT_LE(door.at("width_m").get<double>(), 2.0);
+  }
+  const nlohmann::json geo = readJson(out / "places.geojson");
+  EXPECT_EQ(geo.at("type"), "FeatureCollection");
+  EXPECT_EQ(geo.at("features").size(), places.at("places").size() + places.at("doors").size());
+  // The label map: map_server's YAML naming a PNG of the grid's size.
+  const nlohmann::json& grid = places.at("grid");
+  const std::string yaml = readFile(out / "places.yaml");
+  EXPECT_NE(yaml.find("image: places.png\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("mode: raw\n"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("origin: ["), std::string::npos) << yaml;
+  const std::string png = readFile(out / "places.png");
+  ASSERT_GT(png.size(), 25u);
+  const auto big_endian = [&png](std::size_t at) {
+    return (unsigned(std::uint8_t(png[at])) << 24) | (unsigned(std::uint8_t(png[at + 1])) << 16) |
+           (unsigned(std::uint8_t(png[at + 2])) << 8) | unsigned(std::uint8_t(png[at + 3]));
+  };
+  EXPECT_EQ(big_endian(16), grid.at("width").get<unsigned>());
+  EXPECT_EQ(big_endian(20), grid.at("height").get<unsigned>());
+  EXPECT_EQ(int(png[24]), 8);  // bit depth: every id below 255
+  const std::string pgm = readFile(out / "occupancy.pgm");
+  const std::string header = "P5\n" + std::to_string(grid.at("width").get<int>()) + " " +
+                             std::to_string(grid.at("height").get<int>()) + "\n255\n";
+  EXPECT_EQ(pgm.substr(0, header.size()), header);
+  EXPECT_EQ(pgm.size(), header.size() + grid.at("width").get<std::size_t>() * grid.at("height").get<std::size_t>());
+  EXPECT_NE(readFile(out / "occupancy.yaml").find("image: occupancy.pgm\n"), std::string::npos);
+}
+
 void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
+  expectPlaces(out, partition);
   const std::size_t groups = partition.at("groups").size();
   for (std::size_t g = 0; g < groups; ++g) {
     char name[32];
@@ -955,8 +1004,11 @@ TEST_F(Cli, OnePicturePerLocalMapOnlyWithPictures) {
   const Result off = run("partition " + input + " -q --no-pictures --force -o " + out.string());
   ASSERT_EQ(off.code, 0) << off.err;
   EXPECT_EQ(namesIn(out / "local_maps", "group_", ".pcd").size(), groups);
-  for (const auto& entry : fs::recursive_directory_iterator(out))
+  for (const auto& entry : fs::recursive_directory_iterator(out)) {
+    if (entry.path().filename() == "places.png") continue;  // the label map is data, not a picture
     EXPECT_TRUE(entry.path().extension() != ".png" && entry.path().extension() != ".svg") << entry.path();
+  }
+  EXPECT_TRUE(fs::exists(out / "places.png"));
 }
 
 TEST_F(Cli, TheMapPictureShowsTheRefinedPoses) {
@@ -1340,7 +1392,8 @@ namespace {
 /// The "groups" of a partition.json as written: the text between its key and "splits".
 std::string groupsText(const fs::path& out) {
   const std::string text = readFile(out / "partition.json");
-  const std::size_t begin = text.find("\"groups\":"), end = text.find("\"splits\":");
+  // The groups, not their ids: the stream's are the online grouping's own.
+  const std::size_t begin = text.find("\"groups\":"), end = text.find("\"place_ids\":");
   return begin == std::string::npos || end == std::string::npos ? "" : text.substr(begin, end - begin);
 }
 

@@ -18,11 +18,14 @@ struct GroupingOutcome {
   /// into its OnlineGrouping). After a batch run, also its results.
   ObservationGrouping<PointT> grouping;
   Partition partition;
+  /// The place id of each group of `partition` (places.json, partition.json's place_ids).
+  std::vector<int> place_ids;
   WeightMatrix W;
   /// Points of each observation after filtering, as the overlap counts them.
   std::vector<std::size_t> points_per_observation;
-  /// The observations' points in the common frame for the pictures: the
-  /// batch's own (setKeepWorldPoints), or the stream's (SensedSpaceOverlap::toWorld).
+  /// The observations' points in the common frame for the places and the
+  /// pictures: the batch's own (setKeepWorldPoints), or the stream's
+  /// (SensedSpaceOverlap::toWorld).
   WorldPoints stream_world;
   bool online = false;
   /// pairs_evaluated, point_tests, edges, and what else the mode measures.

@@ -16,9 +16,10 @@ namespace obsgroup::io {
 
 namespace fs = std::filesystem;
 
-const char* const OutputFolder::kResultFiles[] = {"partition.json", "topology.json", "topology.dot", "map.png",
-                                                  "map.svg",        "weights.png",   "fiedler.png",  "local_maps",
-                                                  nullptr};
+const char* const OutputFolder::kResultFiles[] = {
+    "partition.json", "topology.json",  "topology.dot", "map.png",       "map.svg",       "weights.png",
+    "fiedler.png",    "local_maps",     "places.json",  "places.geojson", "places.png",    "places.yaml",
+    "occupancy.pgm",  "occupancy.yaml", nullptr};
 
 namespace {
 

@@ -7,6 +7,7 @@
 #include <obsgroup/io/ros_bag.h>
 #include "local_maps.h"
 #include "output_folder.h"
+#include "place_outputs.h"
 #include <obsgroup/io/pcd_sequence.h>
 #include "pictures.h"
 #include "grouping_outcome.h"
@@ -18,6 +19,7 @@
 #include <obsgroup/maps/topological_map.h>
 #include <obsgroup/common/parallel_for.h>
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/places/place_map.h>
 
 #include <omp.h>
 
@@ -125,12 +127,22 @@ std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& o
   return poses;
 }
 
+/// Each sensor's position re-centred as `world`'s points are.
+template <typename PointT>
+std::vector<Eigen::Vector3d> sensorOrigins(const std::vector<Observation<PointT>>& observations,
+                                           const WorldPoints& world) {
+  std::vector<Eigen::Vector3d> origins;
+  origins.reserve(observations.size());
+  for (const auto& o : observations) origins.push_back(o.pose.translation() - world.origin);
+  return origins;
+}
+
 /// The method's parameters, for the batch and the online grouping alike.
 template <typename PointT>
 void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& grouping) {
   grouping.setInterruptFlag(args.interrupt);
   grouping.setParameters(args.method);
-  grouping.setKeepWorldPoints(args.pictures);  // map.png draws them
+  grouping.setKeepWorldPoints(true);  // the places and map.png are drawn from them
 }
 
 /// Groups the observations at once: the overlap, W and the partition (sec. II-III).
@@ -149,6 +161,7 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
     throw io::InputError(args.input + ": " + e.what());
   }
   bar.finish();
+  for (std::size_t g = 0; g < out.partition.groups.size(); ++g) out.place_ids.push_back(int(g));
   out.W = grouping.getWeightMatrix();
   const auto& overlap = grouping.getOverlap();
   out.points_per_observation = overlap.points_per_observation;
@@ -210,14 +223,13 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
 /// map.png/.svg, weights.png, fiedler.png and a picture per local map.
 template <typename PointT>
 void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
-                  const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
+                  const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps,
+                  const ObservationRegions& regions, const PlaceMap& places) {
   // The points and regions as the grouping saw them, at the input poses;
   // map.png draws each observation at its refined pose.
   const WorldPoints& world = grouped.world();
   const Partition& partition = grouped.partition;
-  ObservationRegions regions;
   const bool tinted = args.method.model != SensedSpaceModel::Points;
-  if (tinted) regions = grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, world);
   // Staged with the other results, so that they appear together or not at all.
   const render::PictureWriter staged = [&out](const std::string& name,
                                               const std::function<void(const std::string&)>& write) {
@@ -225,7 +237,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   };
   render::writeMapPictures(staged, world, posesOf(observations),
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
-                           tinted ? &regions : nullptr);
+                           tinted ? &regions : nullptr, &places);
   render::writeWeightsPicture(staged, grouped.W, partition);
   render::writeFiedlerPicture(staged, partition);
   render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology));
@@ -262,9 +274,30 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
 
 /// Seconds spent writing, pictures included.
 struct OutputTimes {
-  double outputs_s = 0.0, pictures_s = 0.0;
+  double outputs_s = 0.0, pictures_s = 0.0, places_s = 0.0;
   std::size_t map_points = 0;
 };
+
+/// The sensed regions the places are cut from: the grouping's own, or for
+/// the points model (which has none) those of the visibility model's defaults.
+template <typename PointT>
+ObservationRegions regionsOfRun(const PartitionArgs& args, const GroupingOutcome<PointT>& grouped,
+                                const std::vector<Observation<PointT>>& observations) {
+  if (args.method.model != SensedSpaceModel::Points)
+    return grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, grouped.world());
+  return computeRegions(SensedSpaceModel::Visibility, grouped.world(), sensorOrigins(observations, grouped.world()),
+                        RegionParameters{}, args.method.threads, args.interrupt);
+}
+
+/// places.json/.geojson, the label map and the occupancy map.
+void writePlaces(const io::OutputFolder& out, const PlaceMap& places) {
+  out.writeText("places.json", io::placesJson(places));
+  out.writeText("places.geojson", io::placesGeoJson(places));
+  out.write("places.png", [&places](const std::string& path) { io::writePlaceLabels(path, places); });
+  out.writeText("places.yaml", io::mapYaml(places, "places.png", "raw"));
+  out.write("occupancy.pgm", [&places](const std::string& path) { io::writeOccupancyPgm(path, places); });
+  out.writeText("occupancy.yaml", io::mapYaml(places, "occupancy.pgm", "trinary"));
+}
 
 template <typename PointT>
 OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
@@ -275,9 +308,18 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   out.writeText("topology.json", io::topologyJson(maps.topology));
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
+  const auto places_start = Clock::now();
+  const ObservationRegions regions = regionsOfRun(args, grouped, observations);
+  PlaceOptions place_options;
+  place_options.band_low = args.method.regions.band_low;
+  place_options.band_high = args.method.regions.band_high;
+  const PlaceMap places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
+                                        grouped.partition.groups, grouped.place_ids, place_options);
+  writePlaces(out, places);
+  t.places_s = secondsSince(places_start);
   if (args.pictures) {
     const auto pictures_start = Clock::now();
-    drawPictures(args, out, grouped, observations, maps);
+    drawPictures(args, out, grouped, observations, maps, regions, places);
     t.pictures_s = secondsSince(pictures_start);
   }
   t.outputs_s = secondsSince(start);
@@ -304,11 +346,13 @@ io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, con
                          {"refined_members", maps.refinement.moved},
                          {"kept_members", maps.refinement.members - maps.refinement.moved}});
   run.warnings = warn.all();
+  run.place_ids = grouped.place_ids;
   run.timing_s = grouped.timing_s;
   run.timing_s.update({{"load", input.load_s},
                        {"local_maps", maps.seconds},
                        {"outputs", written.outputs_s},
                        {"pictures", written.pictures_s},
+                       {"places", written.places_s},
                        {"threads", threadCount(args.method.threads)}});
   return run;
 }

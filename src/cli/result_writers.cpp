@@ -79,6 +79,7 @@ std::string partitionJson(const Partition& partition, const RunRecord& run) {
   out << "{\n"
       << "  \"observations\": " << partition.group_of.size() << ",\n"
       << "  \"groups\": " << arrayPerLine(partition.groups.size(), group) << ",\n"
+      << "  \"place_ids\": " << nlohmann::json(run.place_ids).dump() << ",\n"
       << "  \"splits\": " << arrayPerLine(partition.splits.size(), split) << ",\n"
       << "  \"parameters\": " << run.parameters.dump() << ",\n"
       << "  \"statistics\": " << run.statistics.dump() << ",\n"

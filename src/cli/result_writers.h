@@ -19,9 +19,12 @@ struct RunRecord {
   nlohmann::json statistics;  ///< points, pairs evaluated, edges of W
   nlohmann::json timing_s;    ///< seconds per stage (the only part that varies between runs)
   std::vector<std::string> warnings;  ///< what the user was warned about, in order
+  /// The place id of each group, in group order (places.json's ids): the
+  /// group's index for `partition`, the online grouping's stable id for `stream`.
+  std::vector<int> place_ids;
 };
 
-/// {"observations": N, "groups": [[...]], "splits": [...], "parameters": {...},
+/// {"observations": N, "groups": [[...]], "place_ids": [...], "splits": [...], "parameters": {...},
 ///  "statistics": {...}, "warnings": [...], "input": "...", "timing_s": {...}}, keys in this order,
 /// one group and one split per line.
 std::string partitionJson(const Partition& partition, const RunRecord& run);

@@ -32,31 +32,11 @@ inline std::string describeChange(const GroupChange& change) {
   return text;
 }
 
-/// Each observation's points after filtering, as the batch overlap counts
-/// them (SensedSpaceOverlap::toWorld), without keeping them.
+/// The observations' points in the common frame, as the batch keeps them
+/// (the places and the pictures draw on them).
 template <typename PointT>
-std::vector<std::size_t> filteredPointCounts(const SensedSpaceOverlap<PointT>& overlap,
-                                             const std::vector<Observation<PointT>>& observations, int threads) {
-  std::vector<std::size_t> counts(observations.size(), 0);
-  if (observations.empty()) return counts;
-  const Eigen::Vector3d origin = observations.front().pose.translation();  // toWorld's, as the voxel grid depends on it
-  parallelFor(observations.size(), threads, 4, [&](std::size_t i) {
-    counts[i] = overlap.observationToWorld(observations[i], origin).size();
-  });
-  return counts;
-}
-
-/// The points the outputs need, as the batch keeps them: all of them for
-/// the pictures, else only how many each observation has (the statistics).
-template <typename PointT>
-void addWorldPoints(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
-                    GroupingOutcome<PointT>& out) {
-  const SensedSpaceOverlap<PointT> overlap = out.grouping.getSensedSpaceOverlap();
-  if (!args.pictures) {
-    out.points_per_observation = filteredPointCounts(overlap, observations, args.method.threads);
-    return;
-  }
-  out.stream_world = overlap.toWorld(observations);
+void addWorldPoints(const std::vector<Observation<PointT>>& observations, GroupingOutcome<PointT>& out) {
+  out.stream_world = out.grouping.getSensedSpaceOverlap().toWorld(observations);
   for (int i = 0; i < out.stream_world.size(); ++i) out.points_per_observation.push_back(out.stream_world.count(i));
 }
 
@@ -132,9 +112,11 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
   const StreamTotals totals = replay(args, online, observations, labels, clock);
   out.online = true;
   out.partition = online.getPartition();
+  const std::vector<int> ids = online.getIds();
+  for (const auto& group : out.partition.groups) out.place_ids.push_back(online.getGroupOf(ids[group.front()]));
   out.W = online.getWeightMatrix();
   const auto start = ReplayClock::Clock::now();
-  addWorldPoints(args, observations, out);
+  addWorldPoints(observations, out);
   const std::size_t edges = edgeCount(out.W);
   // The online overlap counts neither the pairs it tests nor the point
   // tests: pairs_evaluated is the edges (each was evaluated at least once),

@@ -142,8 +142,9 @@ void fillSquare(const View& v, int cx, int cy, int half, std::uint32_t argb, uns
       reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = argb;
 }
 
-/// Each region cell in a pale shade of the group most of whose observations
-/// hold it (ties: the lower group). Cells of 3D regions are seen from above.
+/// Each region cell in a pale shade of the group the largest share of whose
+/// observations hold it (ties: the lower group), the rule of the places'
+/// floor (buildPlaceMap). Cells of 3D regions are seen from above.
 void tintRegions(const ObservationRegions& regions, const Partition& partition, const std::vector<int>& colours,
                  const View& v, unsigned char* data, int stride) {
   std::vector<std::pair<std::uint64_t, int>> cells;  // (plane cell, group)
@@ -158,12 +159,15 @@ void tintRegions(const ObservationRegions& regions, const Partition& partition, 
   std::sort(cells.begin(), cells.end());
   const int half = std::max(1, int(std::ceil(regions.cell_size * v.scale / 2)));
   for (std::size_t a = 0; a < cells.size();) {
-    int best = -1, best_count = 0;
+    int best = -1;
+    std::size_t best_count = 0;
     std::size_t b = a;
     while (b < cells.size() && cells[b].first == cells[a].first) {
       std::size_t e = b;
       while (e < cells.size() && cells[e] == cells[b]) ++e;
-      if (int(e - b) > best_count) best = cells[b].second, best_count = int(e - b);
+      const std::size_t g = std::size_t(cells[b].second);
+      if (best < 0 || (e - b) * partition.groups[std::size_t(best)].size() > best_count * partition.groups[g].size())
+        best = cells[b].second, best_count = e - b;
       b = e;
     }
     const int cx = int(std::int32_t(cells[a].first >> 32)), cy = int(std::int32_t(cells[a].first & 0xffffffffu));
@@ -461,13 +465,44 @@ void drawLegend(cairo_t* cr, const MapLayout& layout, const LegendText& t, const
 
 
 /// The picture over `points` (the rasterised points), without the legend.
+/// Each place's outline in its group's darker colour, each door a black bar
+/// (the places are in the world frame; the view is re-centred on `origin`).
+void drawPlaces(cairo_t* cr, const MapLayout& layout, const PlaceMap& places, const Eigen::Vector3d& origin) {
+  const PictureView& v = layout.view;
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_MITER);
+  cairo_set_line_width(cr, 1.5);
+  for (std::size_t g = 0; g < places.places.size() && g < layout.colours.size(); ++g) {
+    const Rgb c = darker(paletteColour(layout.colours[g]));
+    cairo_set_source_rgb(cr, c.r, c.g, c.b);
+    for (const auto& ring : places.places[g].outline) {
+      for (std::size_t k = 0; k < ring.size(); ++k) {
+        const double x = v.px(ring[k].x() - origin.x()), y = v.py(ring[k].y() - origin.y());
+        if (k == 0) cairo_move_to(cr, x, y);
+        else cairo_line_to(cr, x, y);
+      }
+      cairo_close_path(cr);
+    }
+    cairo_stroke(cr);
+  }
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_set_line_width(cr, 4.0);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
+  for (const Door& d : places.doors) {
+    cairo_move_to(cr, v.px(d.end_a.x() - origin.x()), v.py(d.end_a.y() - origin.y()));
+    cairo_line_to(cr, v.px(d.end_b.x() - origin.x()), v.py(d.end_b.y() - origin.y()));
+  }
+  cairo_stroke(cr);
+}
+
 void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
              const std::vector<Eigen::Vector2d>& positions, const std::vector<double>& headings,
-             const Partition& partition, const TopologicalMap& topology, bool regions) {
+             const Partition& partition, const TopologicalMap& topology, bool regions, const PlaceMap* places,
+             const Eigen::Vector3d& origin) {
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
   cairo_set_source_surface(cr, points, 0, 0);
   cairo_paint(cr);
+  if (places) drawPlaces(cr, layout, *places, origin);
   const MarkSizes sizes = markSizes(layout, positions.size());
   drawArcs(cr, layout, topology, sizes);
   drawPoses(cr, layout, positions, headings, partition, sizes);
@@ -622,7 +657,8 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 
 void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
                       const std::vector<Eigen::Isometry3d>& poses, const std::vector<Eigen::Isometry3d>& drawn,
-                      const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions) {
+                      const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions,
+                      const PlaceMap* places) {
   const WorldPoints world = atDrawnPoses(input_world, poses, drawn);
   std::vector<Eigen::Vector2d> positions;
   std::vector<double> headings;
@@ -632,7 +668,8 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
   const Surface points = rasterPoints(world, partition, layout, regions);
   const auto draw = [&](cairo_surface_t* target) {
     Context cr(cairo_create(target), cairo_destroy);
-    drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr);
+    drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr, places,
+            world.origin);
   };
   Surface png = imageSurface(layout.view.width, layout.view.height);
   draw(png.get());

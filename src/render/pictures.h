@@ -10,6 +10,7 @@
 #include <obsgroup/maps/topological_map.h>
 #include <obsgroup/overlap/sensed_regions.h>
 #include <obsgroup/overlap/world_points.h>
+#include <obsgroup/places/place_map.h>
 #include <obsgroup/partition/recursive_partitioner.h>
 
 #include <functional>
@@ -68,10 +69,13 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 /// `world` holds the points at the input `poses` (the frame of `world` before
 /// re-centring); each observation is drawn at `drawn[i]` (globalPoses()),
 /// its points moved by drawn[i] * poses[i]^-1. The regions are drawn where
-/// they were computed, at the input poses.
+/// they were computed, at the input poses. With places (place k of group k),
+/// each place's outline is drawn in its group's colour and each door as a
+/// short black bar, where they were computed (at the input poses).
 void writeMapPictures(const PictureWriter& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
                       const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
-                      const TopologicalMap& topology, const ObservationRegions* regions = nullptr);
+                      const TopologicalMap& topology, const ObservationRegions* regions = nullptr,
+                      const PlaceMap* places = nullptr);
 
 /// local_maps/group_NNN.png, numbered like writeLocalMaps' PCD files: each
 /// local map's merged points from above in the map's own frame (x right, y

@@ -1,0 +1,127 @@
+#pragma once
+/// \file
+/// Places a robot can use: each group of observations as a floor area (an
+/// outline with its area, centroid and neighbours), the doors between
+/// places, a label grid and an occupancy grid on the same cells, and "which
+/// place holds this pose". Built from the sensed regions the grouping
+/// measured (sensed_regions.h); no PCL.
+
+#include "obsgroup/overlap/sensed_regions.h"
+#include "obsgroup/overlap/world_points.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace obsgroup {
+
+/// A grid over the floor in the world frame: cell (i, j) spans
+/// [origin.x + i * resolution, origin.x + (i + 1) * resolution) in x and the
+/// same in y from origin.y; row j = 0 is the lowest (ROS map_server's
+/// origin is the lower-left corner, as here).
+struct FloorGrid {
+  double resolution = 0.2;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  int width = 0, height = 0;
+
+  std::size_t index(int i, int j) const { return std::size_t(j) * std::size_t(width) + std::size_t(i); }
+  bool contains(int i, int j) const { return i >= 0 && j >= 0 && i < width && j < height; }
+  /// The cell holding a point of the world frame (it may lie outside the grid).
+  Eigen::Vector2i cellOf(const Eigen::Vector2d& p) const;
+  Eigen::Vector2d cellCentre(int i, int j) const;
+};
+
+/// What the observations say of a cell.
+enum class Occupancy : std::uint8_t { Unknown = 0, Free = 1, Occupied = 2 };
+
+/// One place: a group of observations and the floor it holds.
+struct Place {
+  int id = -1;                ///< the group's id (stable across online updates)
+  std::vector<int> members;   ///< observation indices, ascending
+  /// The floor the place holds, as rings of [x, y] in the world frame: outer
+  /// rings counter-clockwise, holes clockwise, each closed implicitly (the
+  /// last vertex joins the first) and simple; rings meet at most at a vertex.
+  std::vector<std::vector<Eigen::Vector2d>> outline;
+  double area_m2 = 0.0;
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  Eigen::AlignedBox2d bbox;    ///< of the outline (empty when the place holds no floor)
+  std::vector<int> neighbours; ///< ids of the places whose floor touches this one's, ascending
+};
+
+/// An opening between two places narrower than a door.
+struct Door {
+  int place_a = -1, place_b = -1;  ///< place ids, place_a < place_b
+  Eigen::Vector2d end_a = Eigen::Vector2d::Zero(), end_b = Eigen::Vector2d::Zero();  ///< the segment across it
+  Eigen::Vector2d midpoint = Eigen::Vector2d::Zero();
+  double width_m = 0.0;
+};
+
+struct PlaceOptions {
+  /// A boundary between two places is a door when it is at most this long
+  /// and ends on both sides at something that is not floor (a wall, or space
+  /// no one sensed), metres.
+  double max_door_width = 2.0;
+  /// Pieces of a place smaller than this are dropped (its largest piece is
+  /// always kept), square metres.
+  double min_piece_area = 0.5;
+  /// Visibility in 3D: the points whose height above their sensor lies in
+  /// [band_low, band_high] are obstacles (RegionParameters' band).
+  double band_low = -0.7, band_high = 0.8;
+};
+
+/// The result of PlaceMap::locate.
+struct Location {
+  std::optional<int> place;  ///< the place id; empty when none is within the tolerance
+  double distance_m = 0.0;   ///< 0 inside a place; else the distance to the nearest cell of `place`
+};
+
+/// Places, doors and the grids they are drawn on.
+struct PlaceMap {
+  FloorGrid grid;
+  /// Per cell: the place id holding it, or -1.
+  std::vector<std::int32_t> labels;
+  /// Per cell: free where some observation sensed it and no point lies in
+  /// it, occupied where points lie, unknown elsewhere.
+  std::vector<Occupancy> occupancy;
+  std::vector<Place> places;
+  std::vector<Door> doors;
+
+  /// The place holding (x, y) of `position`, or the nearest within
+  /// `tolerance` metres (distance to the nearest cell centre), or none.
+  Location locate(const Eigen::Vector2d& position, double tolerance = 1.0) const;
+};
+
+/// The rings of an outline grouped into polygons: for each outer ring (counter-
+/// clockwise) its index first, then the indices of the holes (clockwise) that
+/// lie in it (each in the smallest outer ring holding it). For GeoJSON's
+/// MultiPolygon and the like.
+std::vector<std::vector<std::size_t>> polygonsOf(const std::vector<std::vector<Eigen::Vector2d>>& rings);
+
+/// Twice the signed area of a ring (positive: counter-clockwise).
+double twiceSignedArea(const std::vector<Eigen::Vector2d>& ring);
+
+/// Builds the places of a partition from the observations' sensed regions
+/// (those the grouping measured, or computeRegions(Visibility, ...) for the
+/// points model) and their points (for the obstacles):
+/// - each floor cell (in some region, no point in it) goes to the group the
+///   largest share of whose observations hold it (ties: the lower group): a
+///   room's many scans that see the corridor in front of its door through the
+///   door are a small share of the room's, and the corridor keeps that floor;
+/// - a place's cells that lie on no 2x2 block of its own (one-cell spokes
+///   reaching through a door) and pieces below options.min_piece_area are
+///   left to no place;
+/// - outlines follow the cell edges (4-connected pieces), doors are the
+///   short boundaries between two places that end on walls.
+/// `groups` are observation indices (Partition::groups), `place_ids` one id
+/// per group. `world` is the points as the grouping saw them (re-centred on
+/// world.origin, as the regions are), `sensor_origins` re-centred the same.
+/// Throws std::invalid_argument on sizes that do not match.
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& world,
+                       const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options = {});
+
+}  // namespace obsgroup

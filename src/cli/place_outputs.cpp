@@ -1,0 +1,182 @@
+#include "place_outputs.h"
+
+#include <nlohmann/json.hpp>
+#include <png.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace obsgroup::io {
+
+namespace {
+
+nlohmann::json xy(const Eigen::Vector2d& p) { return nlohmann::json::array({p.x(), p.y()}); }
+
+nlohmann::json ringJson(const std::vector<Eigen::Vector2d>& ring, bool closed) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& p : ring) out.push_back(xy(p));
+  if (closed && !ring.empty()) out.push_back(xy(ring.front()));  // GeoJSON repeats the first position
+  return out;
+}
+
+nlohmann::json bboxJson(const Eigen::AlignedBox2d& box) {
+  if (box.isEmpty()) return nullptr;
+  return {box.min().x(), box.min().y(), box.max().x(), box.max().y()};
+}
+
+nlohmann::json gridJson(const PlaceMap& map) {
+  return {{"resolution", map.grid.resolution},
+          {"origin", xy(map.grid.origin)},
+          {"width", map.grid.width},
+          {"height", map.grid.height},
+          {"labels", "places.png"},
+          {"occupancy", "occupancy.pgm"}};
+}
+
+/// One line per place and per door, like partition.json's groups.
+std::string linesOf(const char* key, const std::vector<nlohmann::json>& items, bool last) {
+  std::string out = std::string("  \"") + key + "\": [";
+  for (std::size_t k = 0; k < items.size(); ++k) out += (k ? ",\n    " : "\n    ") + items[k].dump();
+  out += items.empty() ? "]" : "\n  ]";
+  return out + (last ? "\n" : ",\n");
+}
+
+}  // namespace
+
+std::string placesJson(const PlaceMap& map) {
+  std::vector<nlohmann::json> places, doors;
+  for (const Place& p : map.places) {
+    nlohmann::json outline = nlohmann::json::array();
+    for (const auto& ring : p.outline) outline.push_back(ringJson(ring, false));
+    places.push_back({{"id", p.id},
+                      {"members", p.members},
+                      {"area_m2", p.area_m2},
+                      {"centroid", p.area_m2 > 0 ? xy(p.centroid) : nlohmann::json()},
+                      {"bbox", bboxJson(p.bbox)},
+                      {"neighbours", p.neighbours},
+                      {"outline", outline}});
+  }
+  for (const Door& d : map.doors)
+    doors.push_back({{"places", {d.place_a, d.place_b}},
+                     {"midpoint", xy(d.midpoint)},
+                     {"width_m", d.width_m},
+                     {"segment", {xy(d.end_a), xy(d.end_b)}}});
+  return "{\n" + linesOf("places", places, false) + linesOf("doors", doors, false) +
+         "  \"grid\": " + gridJson(map).dump() + "\n}\n";
+}
+
+std::string placesGeoJson(const PlaceMap& map) {
+  std::vector<nlohmann::json> features;
+  for (const Place& p : map.places) {
+    nlohmann::json polygons = nlohmann::json::array();
+    for (const auto& rings : polygonsOf(p.outline)) {
+      nlohmann::json polygon = nlohmann::json::array();
+      for (std::size_t r : rings) polygon.push_back(ringJson(p.outline[r], true));
+      polygons.push_back(polygon);
+    }
+    features.push_back({{"type", "Feature"},
+                        {"id", p.id},
+                        {"properties",
+                         {{"kind", "place"},
+                          {"id", p.id},
+                          {"area_m2", p.area_m2},
+                          {"observations", p.members.size()},
+                          {"neighbours", p.neighbours}}},
+                        {"geometry", {{"type", "MultiPolygon"}, {"coordinates", polygons}}}});
+  }
+  for (const Door& d : map.doors)
+    features.push_back({{"type", "Feature"},
+                        {"properties", {{"kind", "door"}, {"places", {d.place_a, d.place_b}}, {"width_m", d.width_m}}},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", {xy(d.end_a), xy(d.end_b)}}}}});
+  std::string out = "{\"type\": \"FeatureCollection\",\n \"features\": [";
+  for (std::size_t k = 0; k < features.size(); ++k) out += (k ? ",\n  " : "\n  ") + features[k].dump();
+  return out + (features.empty() ? "]}\n" : "\n ]}\n");
+}
+
+std::string mapYaml(const PlaceMap& map, const std::string& image, const std::string& mode) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "image: " << image << "\n"
+      << "mode: " << mode << "\n"
+      << "resolution: " << map.grid.resolution << "\n"
+      << "origin: [" << map.grid.origin.x() << ", " << map.grid.origin.y() << ", 0.0]\n"
+      << "negate: 0\n"
+      << "occupied_thresh: 0.65\n"
+      << "free_thresh: 0.196\n";
+  return out.str();
+}
+
+namespace {
+
+/// Writes a one-channel PNG from rows top first, `bytes_per_row` each. libpng
+/// reports errors by longjmp, so this function holds nothing that needs a
+/// destructor; returns false on an error.
+bool writeGreyPng(std::FILE* file, int width, int height, int bit_depth, const png_byte* pixels,
+                  std::size_t bytes_per_row) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), bit_depth, PNG_COLOR_TYPE_GRAY,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int r = 0; r < height; ++r) png_write_row(png, pixels + std::size_t(r) * bytes_per_row);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+}  // namespace
+
+void writePlaceLabels(const std::string& path, const PlaceMap& map) {
+  const int width = std::max(1, map.grid.width), height = std::max(1, map.grid.height);
+  int largest = -1;
+  for (int l : map.labels) largest = std::max(largest, l);
+  if (largest + 1 > 65535) throw std::runtime_error(path + ": more than 65534 place ids for a 16-bit label map");
+  const int bit_depth = largest + 1 > 255 ? 16 : 8;
+  const std::size_t bytes_per_row = std::size_t(width) * (bit_depth == 16 ? 2 : 1);
+  std::vector<png_byte> pixels(bytes_per_row * std::size_t(height), 0);
+  for (int r = 0; r < height; ++r) {
+    const int j = map.grid.height - 1 - r;  // the top row is the grid's highest
+    png_byte* row = pixels.data() + std::size_t(r) * bytes_per_row;
+    for (int i = 0; j >= 0 && i < map.grid.width; ++i) {
+      const int value = map.labels[map.grid.index(i, j)] + 1;
+      if (bit_depth == 16) {
+        row[2 * i] = png_byte(value >> 8);  // big-endian, as PNG stores it
+        row[2 * i + 1] = png_byte(value & 0xff);
+      } else {
+        row[i] = png_byte(value);
+      }
+    }
+  }
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) throw std::runtime_error(path + ": cannot write");
+  const bool written = writeGreyPng(file, width, height, bit_depth, pixels.data(), bytes_per_row);
+  if (std::fclose(file) != 0 || !written) throw std::runtime_error(path + ": cannot write the label map");
+}
+
+void writeOccupancyPgm(const std::string& path, const PlaceMap& map) {
+  const int width = std::max(1, map.grid.width), height = std::max(1, map.grid.height);
+  std::ofstream out(path, std::ios::binary);
+  out << "P5\n" << width << " " << height << "\n255\n";
+  std::vector<char> row(std::size_t(width), char(205));
+  for (int r = 0; r < height; ++r) {
+    const int j = map.grid.height - 1 - r;
+    for (int i = 0; i < width; ++i) {
+      const Occupancy o = j >= 0 && i < map.grid.width ? map.occupancy[map.grid.index(i, j)] : Occupancy::Unknown;
+      row[i] = char(o == Occupancy::Occupied ? 0 : o == Occupancy::Free ? 254 : 205);
+    }
+    out.write(row.data(), std::streamsize(row.size()));
+  }
+  if (!out.flush()) throw std::runtime_error(path + ": cannot write");
+}
+
+}  // namespace obsgroup::io

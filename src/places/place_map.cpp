@@ -1,0 +1,533 @@
+#include "obsgroup/places/place_map.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+
+namespace obsgroup {
+
+Eigen::Vector2i FloorGrid::cellOf(const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d cell = ((p - origin) / resolution).array().floor();
+  const double limit = double(std::numeric_limits<int>::max() / 2);
+  return cell.cwiseMax(-limit).cwiseMin(limit).cast<int>();
+}
+
+Eigen::Vector2d FloorGrid::cellCentre(int i, int j) const {
+  return origin + resolution * Eigen::Vector2d(i + 0.5, j + 0.5);
+}
+
+namespace {
+
+constexpr int kNone = -1;
+
+/// The grid over every region cell and every obstacle point, in the
+/// re-centred frame of the regions (`local_origin`), and the world frame.
+struct GridFrame {
+  FloorGrid grid;
+  Eigen::Vector2d local_origin;  // re-centred coordinates of the grid's corner
+  int cellX(double x) const { return int(std::floor((x - local_origin.x()) / grid.resolution)); }
+  int cellY(double y) const { return int(std::floor((y - local_origin.y()) / grid.resolution)); }
+};
+
+bool isObstacle(const Eigen::Vector3f& p, const Eigen::Vector3d& sensor, bool planar, const PlaceOptions& options) {
+  if (planar) return true;
+  const double height = double(p.z()) - sensor.z();
+  return height >= options.band_low && height <= options.band_high;
+}
+
+GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
+                   const std::vector<Eigen::Vector3d>& sensors, const PlaceOptions& options) {
+  const double cs = regions.cell_size;
+  GridFrame f;
+  f.grid.resolution = cs;
+  if (regions.cells.empty()) return f;
+  // Cell edges where the regions' are: a corner half a cell below a region cell's centre.
+  const Eigen::Vector3d first = regions.cellCentre(regions.cells.front());
+  const Eigen::Vector2d base(first.x() - cs / 2, first.y() - cs / 2);
+  Eigen::AlignedBox2d cells;  // in whole cells from `base`
+  const auto extend = [&](double x, double y) {
+    cells.extend(Eigen::Vector2d(std::floor((x - base.x()) / cs), std::floor((y - base.y()) / cs)));
+  };
+  for (std::uint64_t key : regions.cells) {
+    const Eigen::Vector3d c = regions.cellCentre(key);
+    extend(c.x(), c.y());
+  }
+  for (int i = 0; i < world.size(); ++i)
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
+      if (isObstacle(*p, sensors[i], regions.planar, options)) extend(p->x(), p->y());
+  const Eigen::Vector2d size = cells.max() - cells.min() + Eigen::Vector2d::Ones();
+  if (size.x() * size.y() > 4.0e8)
+    throw std::invalid_argument("buildPlaceMap: the floor grid would have more than 400 million cells of " +
+                                std::to_string(cs) + " m");
+  f.grid.width = int(size.x());
+  f.grid.height = int(size.y());
+  f.local_origin = base + cs * cells.min();
+  f.grid.origin = Eigen::Vector2d(world.origin.x(), world.origin.y()) + f.local_origin;
+  return f;
+}
+
+/// Per floor cell, the group most of whose observations hold it (ties: the
+/// lower group), or kNone.
+std::vector<int> ownerOfCells(const ObservationRegions& regions, const GridFrame& f, const std::vector<int>& group_of,
+                              const std::vector<Occupancy>& occupancy) {
+  std::vector<std::pair<std::uint32_t, int>> held;  // (cell index, group), once per observation
+  held.reserve(regions.cells.size());
+  std::vector<std::uint32_t> own;
+  for (int i = 0; i < regions.size(); ++i) {
+    own.clear();
+    for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
+      const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
+      const int x = f.cellX(c.x()), y = f.cellY(c.y());
+      if (f.grid.contains(x, y)) own.push_back(std::uint32_t(f.grid.index(x, y)));
+    }
+    std::sort(own.begin(), own.end());
+    own.erase(std::unique(own.begin(), own.end()), own.end());  // 3D voxels seen from above
+    for (std::uint32_t cell : own) held.emplace_back(cell, group_of[i]);
+  }
+  std::sort(held.begin(), held.end());
+  std::vector<std::size_t> group_size;
+  for (int g : group_of) {
+    if (g >= int(group_size.size())) group_size.resize(std::size_t(g) + 1, 0);
+    ++group_size[std::size_t(g)];
+  }
+  std::vector<int> owner(occupancy.size(), kNone);
+  for (std::size_t a = 0; a < held.size();) {
+    int best = kNone;
+    std::size_t best_count = 0;
+    std::size_t b = a;
+    while (b < held.size() && held[b].first == held[a].first) {
+      std::size_t e = b;
+      while (e < held.size() && held[e] == held[b]) ++e;
+      // The largest share of a group's observations, compared exactly:
+      // count / size > best_count / best_size.
+      const std::size_t g = std::size_t(held[b].second);
+      if (best == kNone || (e - b) * group_size[std::size_t(best)] > best_count * group_size[g])
+        best = held[b].second, best_count = e - b;
+      b = e;
+    }
+    if (occupancy[held[a].first] == Occupancy::Free) owner[held[a].first] = best;
+    a = b;
+  }
+  return owner;
+}
+
+/// Keeps a cell only when some 2x2 block of its label holds it (a morphological
+/// opening by a 2x2 square): one-cell-wide spokes and lines go.
+std::vector<int> openedLabels(const FloorGrid& g, const std::vector<int>& label) {
+  std::vector<int> out(label.size(), kNone);
+  for (int j = 0; j + 1 < g.height; ++j)
+    for (int i = 0; i + 1 < g.width; ++i) {
+      const int l = label[g.index(i, j)];
+      if (l == kNone || label[g.index(i + 1, j)] != l || label[g.index(i, j + 1)] != l ||
+          label[g.index(i + 1, j + 1)] != l)
+        continue;
+      out[g.index(i, j)] = out[g.index(i + 1, j)] = out[g.index(i, j + 1)] = out[g.index(i + 1, j + 1)] = l;
+    }
+  return out;
+}
+
+/// 4-connected pieces of each label: piece id per cell (-1: none) and the
+/// cells of each piece.
+struct Pieces {
+  std::vector<int> piece_of;
+  std::vector<std::vector<std::size_t>> cells;
+  std::vector<int> label;
+};
+
+Pieces piecesOf(const FloorGrid& g, const std::vector<int>& label) {
+  Pieces p;
+  p.piece_of.assign(label.size(), -1);
+  std::vector<std::size_t> stack;
+  for (std::size_t start = 0; start < label.size(); ++start) {
+    if (label[start] == kNone || p.piece_of[start] >= 0) continue;
+    const int id = int(p.cells.size());
+    p.cells.emplace_back();
+    p.label.push_back(label[start]);
+    stack.assign(1, start);
+    p.piece_of[start] = id;
+    while (!stack.empty()) {
+      const std::size_t c = stack.back();
+      stack.pop_back();
+      p.cells[id].push_back(c);
+      const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
+      const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+      for (int n = 0; n < 4; ++n) {
+        const int x = i + di[n], y = j + dj[n];
+        if (!g.contains(x, y)) continue;
+        const std::size_t d = g.index(x, y);
+        if (label[d] == label[start] && p.piece_of[d] < 0) {
+          p.piece_of[d] = id;
+          stack.push_back(d);
+        }
+      }
+    }
+  }
+  return p;
+}
+
+/// Drops the pieces smaller than `min_cells`, except each label's largest.
+void dropSpecks(std::vector<int>& label, const Pieces& pieces, std::size_t min_cells) {
+  std::map<int, std::size_t> largest;  // label -> its largest piece
+  for (std::size_t k = 0; k < pieces.cells.size(); ++k) {
+    const auto it = largest.find(pieces.label[k]);
+    if (it == largest.end() || pieces.cells[k].size() > pieces.cells[it->second].size()) largest[pieces.label[k]] = k;
+  }
+  for (std::size_t k = 0; k < pieces.cells.size(); ++k)
+    if (pieces.cells[k].size() < min_cells && largest[pieces.label[k]] != k)
+      for (std::size_t c : pieces.cells[k]) label[c] = kNone;
+}
+
+using Vertex = std::pair<int, int>;  // grid corner (i, j): the lower-left corner of cell (i, j)
+
+/// Splits a ring that passes a corner twice into rings that do not: a
+/// ring only touching itself is not simple.
+void splitAtRepeatedCorners(std::vector<Vertex> ring, std::vector<std::vector<Vertex>>& out) {
+  std::map<Vertex, std::size_t> seen;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const auto [it, inserted] = seen.emplace(ring[k], k);
+    if (inserted) continue;
+    // ring[it->second .. k) is a loop of its own; the rest goes on without it.
+    std::vector<Vertex> loop(ring.begin() + std::ptrdiff_t(it->second), ring.begin() + std::ptrdiff_t(k));
+    ring.erase(ring.begin() + std::ptrdiff_t(it->second), ring.begin() + std::ptrdiff_t(k));
+    splitAtRepeatedCorners(std::move(loop), out);
+    splitAtRepeatedCorners(std::move(ring), out);
+    return;
+  }
+  out.push_back(std::move(ring));
+}
+
+/// The rings around the cells of one label, interior on the left (outer
+/// rings counter-clockwise, holes clockwise), in grid corners. At a corner
+/// where two of its cells touch only diagonally the ring turns left, so each
+/// 4-connected piece gets its own rings and no ring passes a corner twice.
+std::vector<std::vector<Vertex>> traceRings(const FloorGrid& g, const std::vector<int>& label,
+                                            const std::vector<std::size_t>& cells) {
+  const int l = label[cells.front()];
+  const auto is = [&](int i, int j) { return g.contains(i, j) && label[g.index(i, j)] == l; };
+  // Directed edges by their start corner; direction 0 +x, 1 +y, 2 -x, 3 -y.
+  std::map<Vertex, std::vector<int>> out;
+  for (std::size_t c : cells) {
+    const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
+    if (!is(i, j - 1)) out[{i, j}].push_back(0);
+    if (!is(i + 1, j)) out[{i + 1, j}].push_back(1);
+    if (!is(i, j + 1)) out[{i + 1, j + 1}].push_back(2);
+    if (!is(i - 1, j)) out[{i, j + 1}].push_back(3);
+  }
+  const int dx[4] = {1, 0, -1, 0}, dy[4] = {0, 1, 0, -1};
+  std::vector<std::vector<Vertex>> rings;
+  for (auto& [first, dirs] : out) {
+    while (!dirs.empty()) {
+      std::vector<Vertex> ring;
+      Vertex v = first;
+      int dir = dirs.back();
+      dirs.pop_back();
+      ring.push_back(v);
+      while (true) {
+        v = {v.first + dx[dir], v.second + dy[dir]};
+        if (v == first) {
+          // Close unless `first` holds another edge this ring must take first
+          // (it cannot: corners are left by one edge per visit).
+          break;
+        }
+        ring.push_back(v);
+        auto& next = out.at(v);
+        // Prefer a left turn, then straight, then right.
+        int chosen = -1;
+        for (int turn : {1, 0, 3}) {
+          const int d = (dir + turn) % 4;
+          const auto it = std::find(next.begin(), next.end(), d);
+          if (it != next.end()) {
+            chosen = d;
+            next.erase(it);
+            break;
+          }
+        }
+        if (chosen < 0) throw std::logic_error("buildPlaceMap: an outline does not close");
+        dir = chosen;
+      }
+      splitAtRepeatedCorners(std::move(ring), rings);
+    }
+  }
+  return rings;
+}
+
+/// Drops the corners where a ring goes straight on.
+std::vector<Vertex> withoutStraightCorners(const std::vector<Vertex>& ring) {
+  std::vector<Vertex> out;
+  const std::size_t n = ring.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vertex& a = ring[(k + n - 1) % n];
+    const Vertex& b = ring[k];
+    const Vertex& c = ring[(k + 1) % n];
+    const long cross = long(b.first - a.first) * (c.second - b.second) - long(b.second - a.second) * (c.first - b.first);
+    if (cross != 0) out.push_back(b);
+  }
+  return out;
+}
+
+/// The doors between places. Where two places touch, their contact (the
+/// cell edges between them) is cut into clusters of edges at most two cells
+/// apart: the cells of a door are often held partly by each side, so one
+/// opening makes several short chains. A cluster is a door when it spans at
+/// most options.max_door_width along its main direction; its segment is
+/// that span, through the cluster's mean.
+std::vector<Door> findDoors(const FloorGrid& g, const std::vector<int>& label, const std::vector<int>& place_ids,
+                            const PlaceOptions& options) {
+  // Edge midpoints (in half cells) between two labels, by label pair.
+  std::map<std::pair<int, int>, std::vector<Eigen::Vector2i>> contacts;
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i) {
+      const int a = label[g.index(i, j)];
+      if (a == kNone) continue;
+      if (i + 1 < g.width) {
+        const int b = label[g.index(i + 1, j)];
+        if (b != kNone && b != a) contacts[{std::min(a, b), std::max(a, b)}].push_back({2 * (i + 1), 2 * j + 1});
+      }
+      if (j + 1 < g.height) {
+        const int b = label[g.index(i, j + 1)];
+        if (b != kNone && b != a) contacts[{std::min(a, b), std::max(a, b)}].push_back({2 * i + 1, 2 * (j + 1)});
+      }
+    }
+  std::vector<Door> doors;
+  for (const auto& [pair, mids] : contacts) {
+    std::vector<int> parent(mids.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    const auto root = [&parent](int e) {
+      while (parent[e] != e) e = parent[e] = parent[parent[e]];
+      return e;
+    };
+    // Edges whose midpoints lie within two cells (four half cells) join.
+    std::map<std::pair<int, int>, std::vector<int>> bucket;  // 4x4 half-cell buckets
+    for (int e = 0; e < int(mids.size()); ++e) bucket[{mids[e].x() >> 2, mids[e].y() >> 2}].push_back(e);
+    for (int e = 0; e < int(mids.size()); ++e) {
+      const int bx = mids[e].x() >> 2, by = mids[e].y() >> 2;
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const auto it = bucket.find({bx + dx, by + dy});
+          if (it == bucket.end()) continue;
+          for (int f : it->second)
+            if (f < e && (mids[e] - mids[f]).cwiseAbs().maxCoeff() <= 4) parent[root(e)] = root(f);
+        }
+    }
+    std::map<int, std::vector<int>> clusters;
+    for (int e = 0; e < int(mids.size()); ++e) clusters[root(e)].push_back(e);
+    for (const auto& [r, cluster] : clusters) {
+      // The edges' end corners, in metres, and their main direction.
+      std::vector<Eigen::Vector2d> corners;
+      for (int e : cluster) {
+        const Eigen::Vector2i m = mids[e];
+        const Eigen::Vector2d half = m.x() % 2 == 0 ? Eigen::Vector2d(0, 1) : Eigen::Vector2d(1, 0);
+        const Eigen::Vector2d centre = m.cast<double>();
+        corners.push_back(g.origin + g.resolution / 2 * (centre - half));
+        corners.push_back(g.origin + g.resolution / 2 * (centre + half));
+      }
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      for (const auto& c : corners) mean += c;
+      mean /= double(corners.size());
+      Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+      for (const auto& c : corners) scatter += (c - mean) * (c - mean).transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+      const Eigen::Vector2d axis = eigen.eigenvectors().col(1);
+      // The bar across the opening: the corners' extent along that direction, through their mean.
+      double lo = 0, hi = 0;
+      for (const auto& c : corners) {
+        lo = std::min(lo, (c - mean).dot(axis));
+        hi = std::max(hi, (c - mean).dot(axis));
+      }
+      const double width = hi - lo;
+      if (width > options.max_door_width) continue;
+      Door d;
+      d.place_a = place_ids[pair.first];
+      d.place_b = place_ids[pair.second];
+      if (d.place_a > d.place_b) std::swap(d.place_a, d.place_b);
+      d.end_a = mean + lo * axis;
+      d.end_b = mean + hi * axis;
+      d.midpoint = (d.end_a + d.end_b) / 2;
+      d.width_m = (d.end_b - d.end_a).norm();
+      doors.push_back(d);
+    }
+  }
+  std::sort(doors.begin(), doors.end(), [](const Door& x, const Door& y) {
+    return std::tie(x.place_a, x.place_b, x.midpoint.x(), x.midpoint.y()) <
+           std::tie(y.place_a, y.place_b, y.midpoint.x(), y.midpoint.y());
+  });
+  return doors;
+}
+
+}  // namespace
+
+double twiceSignedArea(const std::vector<Eigen::Vector2d>& ring) {
+  double twice = 0;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Eigen::Vector2d& a = ring[k];
+    const Eigen::Vector2d& b = ring[(k + 1) % ring.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return twice;
+}
+
+namespace {
+
+/// Even-odd point in ring.
+bool inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
+  bool in = false;
+  for (std::size_t k = 0, l = ring.size() - 1; k < ring.size(); l = k++) {
+    const Eigen::Vector2d& a = ring[k];
+    const Eigen::Vector2d& b = ring[l];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return in;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::size_t>> polygonsOf(const std::vector<std::vector<Eigen::Vector2d>>& rings) {
+  std::vector<std::vector<std::size_t>> polygons;
+  std::vector<std::size_t> polygon_of_outer(rings.size(), 0);
+  for (std::size_t r = 0; r < rings.size(); ++r)
+    if (rings[r].size() >= 3 && twiceSignedArea(rings[r]) > 0) {
+      polygon_of_outer[r] = polygons.size();
+      polygons.push_back({r});
+    }
+  for (std::size_t h = 0; h < rings.size(); ++h) {
+    if (rings[h].size() < 3 || twiceSignedArea(rings[h]) >= 0) continue;
+    // A point just inside the floor beside the hole's first edge (on its left).
+    const Eigen::Vector2d a = rings[h][0], b = rings[h][1];
+    const Eigen::Vector2d along = (b - a).normalized();
+    const Eigen::Vector2d probe = (a + b) / 2 + 1e-6 * (b - a).norm() * Eigen::Vector2d(-along.y(), along.x());
+    std::size_t best = rings.size();
+    double best_area = std::numeric_limits<double>::infinity();
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+      if (rings[r].size() < 3) continue;
+      const double area = twiceSignedArea(rings[r]);
+      if (area > 0 && area < best_area && inside(rings[r], probe)) best = r, best_area = area;
+    }
+    if (best < rings.size()) polygons[polygon_of_outer[best]].push_back(h);
+  }
+  return polygons;
+}
+
+Location PlaceMap::locate(const Eigen::Vector2d& position, double tolerance) const {
+  Location out;
+  if (grid.width == 0 || !position.allFinite()) return out;
+  const Eigen::Vector2i c = grid.cellOf(position);
+  if (grid.contains(c.x(), c.y()) && labels[grid.index(c.x(), c.y())] >= 0) {
+    out.place = labels[grid.index(c.x(), c.y())];
+    return out;
+  }
+  if (!(tolerance > 0)) return out;
+  const int reach = int(std::ceil(tolerance / grid.resolution)) + 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (int j = std::max(0, c.y() - reach); j <= std::min(grid.height - 1, c.y() + reach); ++j)
+    for (int i = std::max(0, c.x() - reach); i <= std::min(grid.width - 1, c.x() + reach); ++i) {
+      const int l = labels[grid.index(i, j)];
+      if (l < 0) continue;
+      const double d = (grid.cellCentre(i, j) - position).norm();
+      if (d <= tolerance && (d < best || (d == best && l < *out.place))) {
+        best = d;
+        out.place = l;
+      }
+    }
+  if (out.place) out.distance_m = best;
+  return out;
+}
+
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& world,
+                       const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options) {
+  const int n = regions.size();
+  if (world.size() != n || int(sensor_origins.size()) != n)
+    throw std::invalid_argument("buildPlaceMap: regions, points and sensor origins of " + std::to_string(n) + ", " +
+                                std::to_string(world.size()) + " and " + std::to_string(sensor_origins.size()) +
+                                " observations");
+  if (place_ids.size() != groups.size())
+    throw std::invalid_argument("buildPlaceMap: one place id per group expected");
+  std::vector<int> group_of(n, kNone);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int i : groups[g]) {
+      if (i < 0 || i >= n || group_of[i] != kNone)
+        throw std::invalid_argument("buildPlaceMap: observation " + std::to_string(i) +
+                                    " is out of range or in two groups");
+      group_of[i] = int(g);
+    }
+  if (std::find(group_of.begin(), group_of.end(), kNone) != group_of.end())
+    throw std::invalid_argument("buildPlaceMap: every observation must be in a group");
+
+  PlaceMap map;
+  const GridFrame f = makeGrid(regions, world, sensor_origins, options);
+  const FloorGrid& g = f.grid;
+  map.grid = g;
+  const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
+  map.occupancy.assign(cells, Occupancy::Unknown);
+  for (std::uint64_t key : regions.cells) {
+    const Eigen::Vector3d c = regions.cellCentre(key);
+    map.occupancy[g.index(f.cellX(c.x()), f.cellY(c.y()))] = Occupancy::Free;
+  }
+  for (int i = 0; i < n; ++i)
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
+      if (isObstacle(*p, sensor_origins[i], regions.planar, options))
+        map.occupancy[g.index(f.cellX(p->x()), f.cellY(p->y()))] = Occupancy::Occupied;
+
+  std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, f, group_of, map.occupancy)) : std::vector<int>{};
+  const double cell_area = g.resolution * g.resolution;
+  dropSpecks(label, piecesOf(g, label), std::size_t(std::ceil(options.min_piece_area / cell_area)));
+  const Pieces pieces = piecesOf(g, label);
+
+  map.places.resize(groups.size());
+  std::vector<std::size_t> cell_count(groups.size(), 0);
+  std::vector<Eigen::Vector2d> centre_sum(groups.size(), Eigen::Vector2d::Zero());
+  std::vector<std::vector<char>> touches(groups.size(), std::vector<char>(groups.size(), 0));
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i) {
+      const int l = label[g.index(i, j)];
+      if (l == kNone) continue;
+      ++cell_count[l];
+      centre_sum[l] += g.cellCentre(i, j);
+      if (i + 1 < g.width) {
+        const int r = label[g.index(i + 1, j)];
+        if (r != kNone && r != l) touches[l][r] = touches[r][l] = 1;
+      }
+      if (j + 1 < g.height) {
+        const int u = label[g.index(i, j + 1)];
+        if (u != kNone && u != l) touches[l][u] = touches[u][l] = 1;
+      }
+    }
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    Place& place = map.places[k];
+    place.id = place_ids[k];
+    place.members = groups[k];
+    place.area_m2 = double(cell_count[k]) * cell_area;
+    if (cell_count[k] > 0) place.centroid = centre_sum[k] / double(cell_count[k]);
+    for (std::size_t o = 0; o < groups.size(); ++o)
+      if (touches[k][o]) place.neighbours.push_back(place_ids[o]);
+    std::sort(place.neighbours.begin(), place.neighbours.end());
+  }
+  for (std::size_t p = 0; p < pieces.cells.size(); ++p) {
+    Place& place = map.places[pieces.label[p]];
+    for (const auto& ring : traceRings(g, label, pieces.cells[p])) {
+      std::vector<Eigen::Vector2d> points;
+      for (const Vertex& v : withoutStraightCorners(ring)) {
+        points.push_back(g.origin + g.resolution * Eigen::Vector2d(v.first, v.second));
+        place.bbox.extend(points.back());
+      }
+      place.outline.push_back(std::move(points));
+    }
+  }
+  map.doors = findDoors(g, label, place_ids, options);
+  map.labels.assign(cells, -1);
+  for (std::size_t c = 0; c < cells; ++c)
+    if (label[c] != kNone) map.labels[c] = place_ids[label[c]];
+  return map;
+}
+
+}  // namespace obsgroup

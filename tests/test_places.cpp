@@ -1,0 +1,175 @@
+// Places: outlines that are valid polygons, doors between neighbours, the
+// label grid and "which place holds this pose".
+#include "scenarios.h"
+#include "test_support.h"
+
+#include <obsgroup/observation_grouping.h>
+#include <obsgroup/places/place_map.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace obsgroup {
+namespace {
+
+double signedArea(const std::vector<Eigen::Vector2d>& ring) {
+  double twice = 0;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Eigen::Vector2d& a = ring[k];
+    const Eigen::Vector2d& b = ring[(k + 1) % ring.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return twice / 2;
+}
+
+/// Whether segments ab and cd cross at a point inside both (touching at an
+/// end point, as rings sharing a corner do, is not crossing).
+bool properlyCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+    const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+    return v > 1e-12 ? 1 : v < -1e-12 ? -1 : 0;
+  };
+  const int s1 = side(a, b, c), s2 = side(a, b, d), s3 = side(c, d, a), s4 = side(c, d, b);
+  if (s1 * s2 < 0 && s3 * s4 < 0) return true;
+  // Collinear overlap along a stretch.
+  if (s1 == 0 && s2 == 0) {
+    const Eigen::Vector2d u = b - a;
+    const double t0 = (c - a).dot(u) / u.squaredNorm(), t1 = (d - a).dot(u) / u.squaredNorm();
+    return std::max(std::min(t0, t1), 0.0) < std::min(std::max(t0, t1), 1.0) - 1e-9;
+  }
+  return false;
+}
+
+/// Every ring closed (3+ corners), simple (no corner twice, no crossing), and
+/// no two rings crossing; outer rings counter-clockwise, holes clockwise, so
+/// that the signed areas sum to the place's area.
+void expectValidOutline(const Place& place, double cell_area) {
+  double area = 0;
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> edges;
+  for (const auto& ring : place.outline) {
+    ASSERT_GE(ring.size(), 4u) << "place " << place.id;  // cell outlines have right angles only
+    std::set<std::pair<double, double>> corners;
+    for (const auto& p : ring) EXPECT_TRUE(corners.insert({p.x(), p.y()}).second) << "place " << place.id;
+    area += signedArea(ring);
+    for (std::size_t k = 0; k < ring.size(); ++k) edges.push_back({ring[k], ring[(k + 1) % ring.size()]});
+  }
+  EXPECT_NEAR(area, place.area_m2, 1e-6 * std::max(1.0, place.area_m2)) << "place " << place.id;
+  EXPECT_NEAR(std::fmod(place.area_m2 / cell_area + 0.5, 1.0), 0.5, 1e-6);
+  for (std::size_t a = 0; a < edges.size(); ++a)
+    for (std::size_t b = a + 1; b < edges.size(); ++b)
+      ASSERT_FALSE(properlyCross(edges[a].first, edges[a].second, edges[b].first, edges[b].second))
+          << "place " << place.id << ": edges " << a << " and " << b << " cross";
+}
+
+struct Grouped {
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  Partition partition;
+  PlaceMap places;
+};
+
+Grouped groupAndPlace(const sim::Building& building, std::size_t every = 1) {
+  std::vector<sim::Pose2D> route;
+  for (std::size_t k = 0; k < building.route.size(); k += every) route.push_back(building.route[k]);
+  Grouped out;
+  out.observations = test::simulate<pcl::PointXYZ>(building.plan, route, sim::laser360());
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  grouping.setKeepWorldPoints(true);
+  for (const auto& o : out.observations) grouping.addObservation(o.cloud, o.pose);
+  out.partition = grouping.compute();
+  const auto overlap = grouping.getSensedSpaceOverlap();
+  const ObservationRegions regions = overlap.computeRegions(out.observations, grouping.getWorldPoints());
+  std::vector<Eigen::Vector3d> sensors;
+  for (const auto& o : out.observations) sensors.push_back(o.pose.translation() - grouping.getWorldPoints().origin);
+  std::vector<int> ids;
+  for (std::size_t g = 0; g < out.partition.groups.size(); ++g) ids.push_back(int(100 + g));  // not the indices
+  out.places = buildPlaceMap(regions, grouping.getWorldPoints(), sensors, out.partition.groups, ids);
+  return out;
+}
+
+TEST(Places, OutlinesAreValidPolygonsAndDoorsJoinNeighbours) {
+  const Grouped g = groupAndPlace(sim::makeBuilding("office"));
+  const PlaceMap& map = g.places;
+  ASSERT_EQ(map.places.size(), g.partition.groups.size());
+  const double cell_area = map.grid.resolution * map.grid.resolution;
+  std::map<int, const Place*> by_id;
+  double total = 0;
+  for (const Place& place : map.places) {
+    by_id[place.id] = &place;
+    expectValidOutline(place, cell_area);
+    total += place.area_m2;
+    if (place.area_m2 > 0) {
+      // The centroid lies in the bounding box, and the label grid agrees with the area.
+      EXPECT_TRUE(place.bbox.contains(place.centroid));
+      std::size_t cells = 0;
+      for (int l : map.labels) cells += l == place.id;
+      EXPECT_NEAR(double(cells) * cell_area, place.area_m2, 1e-9);
+    }
+  }
+  EXPECT_GT(total, 50.0);  // the office's floor, most of it
+  for (const Place& place : map.places)
+    for (int n : place.neighbours) {
+      ASSERT_TRUE(by_id.count(n));
+      const auto& back = by_id[n]->neighbours;
+      EXPECT_TRUE(std::binary_search(back.begin(), back.end(), place.id)) << place.id << " and " << n;
+    }
+  ASSERT_FALSE(map.doors.empty());
+  for (const Door& d : map.doors) {
+    ASSERT_TRUE(by_id.count(d.place_a) && by_id.count(d.place_b));
+    EXPECT_LT(d.place_a, d.place_b);
+    const auto& n = by_id[d.place_a]->neighbours;
+    EXPECT_TRUE(std::binary_search(n.begin(), n.end(), d.place_b));
+    EXPECT_GT(d.width_m, 0.0);
+    EXPECT_LE(d.width_m, PlaceOptions{}.max_door_width);
+    EXPECT_NEAR((d.end_a - d.end_b).norm(), d.width_m, 1e-9);
+    EXPECT_TRUE(d.midpoint.isApprox((d.end_a + d.end_b) / 2));
+  }
+  // No cell is labelled and not free; occupied cells (walls) hold no place.
+  for (std::size_t c = 0; c < map.labels.size(); ++c) {
+    if (map.labels[c] >= 0) {
+      EXPECT_EQ(map.occupancy[c], Occupancy::Free);
+    }
+  }
+}
+
+TEST(Places, LocateReturnsTheOwnPlaceOfMostObservations) {
+  const Grouped g = groupAndPlace(sim::makeBuilding("office"));
+  std::vector<int> id_of_group;
+  for (const Place& p : g.places.places) id_of_group.push_back(p.id);
+  int own = 0, located = 0;
+  for (std::size_t i = 0; i < g.observations.size(); ++i) {
+    const Eigen::Vector2d at = g.observations[i].pose.translation().head<2>();
+    const Location l = g.places.locate(at, 1.0);
+    if (!l.place) continue;
+    ++located;
+    own += *l.place == id_of_group[g.partition.group_of[i]];
+    if (l.distance_m > 0) {
+      EXPECT_LE(l.distance_m, 1.0);
+    }
+  }
+  const int n = int(g.observations.size());
+  EXPECT_EQ(located, n);  // every pose lies on sensed floor
+  // A scan standing in a doorway joins the group its overlap says, while the
+  // floor under it goes to the side holding it most: 2 of the 150 land next door.
+  EXPECT_GE(own, 0.95 * n) << own << " of " << n;
+  // Far from everything: no place.
+  EXPECT_FALSE(g.places.locate(Eigen::Vector2d(1e4, 1e4)).place);
+  EXPECT_FALSE(g.places.locate(Eigen::Vector2d(NAN, 0)).place);
+}
+
+TEST(Places, BadArgumentsAreRefused) {
+  ObservationRegions regions;
+  WorldPoints world;
+  EXPECT_THROW(buildPlaceMap(regions, world, {Eigen::Vector3d::Zero()}, {}, {}), std::invalid_argument);
+  EXPECT_THROW(buildPlaceMap(regions, world, {}, {{0}}, {}), std::invalid_argument);
+  EXPECT_THROW(buildPlaceMap(regions, world, {}, {{0}}, {7}), std::invalid_argument);  // no observation 0
+  const PlaceMap empty = buildPlaceMap(regions, world, {}, {}, {});
+  EXPECT_TRUE(empty.places.empty());
+  EXPECT_FALSE(empty.locate(Eigen::Vector2d::Zero()).place);
+}
+
+}  // namespace
+}  // namespace obsgroup
