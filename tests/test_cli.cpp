@@ -670,7 +670,7 @@ TEST_F(Cli, UsageMessagesSayWhatIsWrong) {
     EXPECT_EQ(r.err.find("1797"), std::string::npos) << r.err;
   };
   expectUsage("", "a command is required: partition");
-  expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition, stream)");
+  expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition, stream, locate)");
   expectUsage("partition " + input + out + " --sso points --delta 0", "--delta: must be > 0 (got 0)");
   expectUsage("partition " + input + out + " --sso points --delta 0.2cm", "'0.2cm' is not a number");
   expectUsage("partition " + input + out + " --sso points --delta nan", "'nan' is not a finite number");
@@ -1519,4 +1519,48 @@ TEST_F(Cli, StreamRealtimeReplaysAtTheLogsStamps) {
                                  "observation 0:"),
             130);
   EXPECT_FALSE(fs::exists(dir_ / "s"));
+}
+
+TEST_F(Cli, LocateFindsEachObservationsPlaceAndRefusesWhatItCannotUse) {
+  const std::string input = kData + "/office_2d/office.clf";
+  const fs::path run1 = dir_ / "run1", located = dir_ / "located.json";
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + run1.string()).code, 0);
+  const Result r = run("locate " + run1.string() + " " + input + " -o " + located.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("77 observations: 77 in a place"), std::string::npos) << r.err;
+  // The run's own poses lie in their own groups' places.
+  const nlohmann::json partition = readJson(run1 / "partition.json");
+  std::map<int, int> place_of;
+  for (std::size_t g = 0; g < partition.at("groups").size(); ++g)
+    for (int i : partition.at("groups")[g]) place_of[i] = partition.at("place_ids")[g];
+  const nlohmann::json locations = readJson(located).at("locations");
+  ASSERT_EQ(locations.size(), 77u);
+  for (const auto& l : locations) {
+    const int i = l.at("observation");
+    EXPECT_EQ(l.at("place"), place_of.at(i)) << l.dump();
+    EXPECT_EQ(l.at("distance_m"), 0.0);
+    EXPECT_NE(l.at("source").get<std::string>().find("office.clf:"), std::string::npos);
+    EXPECT_TRUE(l.at("stamp").is_number());
+  }
+  // Nothing the user gave is overwritten without asking, and no folder of places means usage.
+  const std::string before = readFile(located);
+  const Result again = run("locate " + run1.string() + " " + input + " -o " + located.string());
+  EXPECT_EQ(again.code, 2);
+  EXPECT_NE(again.err.find("exists; --force replaces it"), std::string::npos) << again.err;
+  EXPECT_EQ(readFile(located), before);
+  EXPECT_EQ(run("locate " + run1.string() + " " + input + " --force -q -o " + located.string()).code, 0);
+  const Result no_places = run("locate " + dir_.string() + " " + input + " -o " + (dir_ / "x.json").string());
+  EXPECT_EQ(no_places.code, 2);
+  EXPECT_NE(no_places.err.find("holds no obsgroup places"), std::string::npos) << no_places.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.json"));
+  // An input that fails to read is exit 3, as for partition.
+  std::ofstream(dir_ / "bad.clf") << "FLASER 3 1.0 1.0\n";
+  const Result bad = run("locate " + run1.string() + " " + (dir_ / "bad.clf").string() + " -o " + (dir_ / "y.json").string());
+  EXPECT_EQ(bad.code, 3) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "y.json"));
+  // A damaged label map names its file.
+  std::ofstream(run1 / "places.png") << "not a png";
+  const Result damaged = run("locate " + run1.string() + " " + input + " -o " + (dir_ / "z.json").string());
+  EXPECT_EQ(damaged.code, 3);
+  EXPECT_NE(damaged.err.find("places.png"), std::string::npos) << damaged.err;
 }

@@ -45,13 +45,14 @@ using cli::oneOf;
 using cli::wholeNumber;
 
 /// INPUT, -o and --format.
-void addInputOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+void addInputOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args,
+                     const std::string& output_help = "folder to write the results to") {
   command.add_option("input", args.input,
                      "CARMEN log (.clf, .log, .gfs.log, gzipped or not; - reads standard input), folder of .pcd files, "
                      "depth images (TUM RGB-D, Redwood), KITTI odometry, ROS 1 bag (.bag) or ROS 2 bag (sqlite3 "
                      "folder)")
       ->required();
-  command.add_option("-o,--output", args.output, "folder to write the results to")->required();
+  command.add_option("-o,--output", args.output, output_help)->required();
   command.add_option("--format", args.format, "input format (default: from the input)")
       ->check(CLI::IsMember({"auto", "carmen", "pcd", "tum-rgbd", "redwood", "kitti", "ros1", "ros2"}))
       ->option_text("auto|carmen|pcd|tum-rgbd|redwood|kitti|ros1|ros2");
@@ -235,6 +236,28 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   addRunOptions(command, args);
 }
 
+/// `locate PLACES INPUT -o FILE.json`: the places of a run, an input read as
+/// partition reads it, and where the locations go.
+void addLocateOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, obsgroup::cli::LocateOptions& locate) {
+  command.add_option("places", locate.places,
+                     "output folder of `obsgroup partition` or `obsgroup stream` (its places.yaml and places.png)")
+      ->required();
+  addInputOptions(command, args, "JSON file to write the locations to");
+  addCarmenOptions(command, args);
+  addPcdOptions(command, args);
+  addDepthOptions(command, args);
+  addBagOptions(command, args);
+  command.add_option("--tolerance", locate.tolerance,
+                     "a pose on no place takes the nearest place within this, metres (0: none)")
+      ->check(finiteNumber(0.0))
+      ->capture_default_str();
+  command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
+      ->check(wholeNumber(0))
+      ->capture_default_str();
+  command.add_flag("--force", args.force, "replace the output file");
+  command.add_flag("-q,--quiet", args.quiet, "no summary or warnings on stderr");
+}
+
 /// What `stream` adds: how often to update, and the replay's pace.
 void addStreamOptions(CLI::App& command, obsgroup::cli::StreamOptions& stream) {
   command.add_option("--update-every", stream.update_every,
@@ -275,12 +298,17 @@ std::optional<std::string> commandError(int argc, char** argv, const CLI::App& a
   return "unknown command '" + first + "' (commands: " + names + ")";
 }
 
+/// --pose-format without a poses file: a mistake whatever the command.
+bool poseFormatWithoutPoses(const CLI::App& command, const obsgroup::cli::PartitionArgs& args) {
+  return command.count("--pose-format") && !args.poses;
+}
+
 /// The options that only make sense together, and the --paper preset.
 /// Returns the usage error, if any.
 std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cli::PartitionArgs& args) {
   using obsgroup::SensedSpaceModel;
   using obsgroup::SplitCriterion;
-  if (partition.count("--pose-format") && !args.poses) return "--pose-format applies to a --poses file (PCD sequences)";
+  if (poseFormatWithoutPoses(partition, args)) return "--pose-format applies to a --poses file (PCD sequences)";
   if (args.paper) {
     const obsgroup::GroupingParameters paper = obsgroup::GroupingParameters::paper();
     if (partition.count("--sso") && args.method.model != paper.model)
@@ -338,6 +366,11 @@ int main(int argc, char** argv) {
                 "groups as it happens on stdout (-q: not); then write what partition writes");
   addPartitionOptions(*stream, args);
   addStreamOptions(*stream, stream_options);
+  obsgroup::cli::LocateOptions locate_options;
+  CLI::App* locate = app.add_subcommand(
+      "locate", "which place each observation of an input is in (poses in the map's frame), from the places of an "
+                "earlier partition or stream; written as JSON");
+  addLocateOptions(*locate, args, locate_options);
 
   const auto usage = [](const std::string& message) {
     std::fprintf(stderr, "obsgroup: error: %s\n", message.c_str());
@@ -353,7 +386,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   const bool streaming = stream->parsed();
-  if (const auto error = settleOptions(streaming ? *stream : *partition, args)) return usage(*error);
+  if (locate->parsed()) {
+    if (poseFormatWithoutPoses(*locate, args)) return usage("--pose-format applies to a --poses file (PCD sequences)");
+    args.locate = locate_options;
+  } else if (const auto error = settleOptions(streaming ? *stream : *partition, args)) {
+    return usage(*error);
+  }
   if (streaming) args.stream = stream_options;
 
   args.interrupt = &interrupt_requested;

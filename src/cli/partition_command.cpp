@@ -29,6 +29,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 namespace obsgroup::cli {
 
@@ -393,8 +394,60 @@ void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std
   printWritten(args);
 }
 
+/// Writes `text` to `path` through a temporary file beside it, so that the
+/// file is whole or absent; an existing file is replaced only with --force.
+void writeFileAtomically(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".obsgroup-partial";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    if (!out.flush()) throw io::InputError(temporary + ": cannot write");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw io::InputError(path + ": cannot write");
+  }
+}
+
+/// `obsgroup locate`: each observation's place in the places of a run.
+template <typename PointT>
+int locateObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
+                       const InputRecord& input) {
+  Warnings warn(args.quiet);
+  for (const auto& w : input.warnings) warn(w);
+  const PlaceMap places = io::readPlaceLabels(args.locate->places);
+  const double tolerance = args.locate->tolerance;
+  std::string text = "{\"places\": " + nlohmann::json(args.locate->places).dump() +
+                     ", \"tolerance_m\": " + nlohmann::json(tolerance).dump() + ",\n \"locations\": [";
+  std::size_t inside = 0, near = 0;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    throwIfInterrupted(args.interrupt);
+    const Eigen::Vector2d position = observations[i].pose.translation().template head<2>();
+    const Location at = places.locate(position, tolerance);
+    inside += at.place && at.distance_m == 0;
+    near += at.place && at.distance_m > 0;
+    const nlohmann::json line = {
+        {"observation", i},
+        {"source", input.labels.at(i)},
+        {"stamp", input.stamps.empty() ? nlohmann::json() : nlohmann::json(input.stamps[i])},
+        {"place", at.place ? nlohmann::json(*at.place) : nlohmann::json()},
+        {"distance_m", at.place ? nlohmann::json(at.distance_m) : nlohmann::json()}};
+    text += (i ? ",\n  " : "\n  ") + line.dump();
+  }
+  text += observations.empty() ? "]}\n" : "\n ]}\n";
+  writeFileAtomically(args.output, text);
+  if (!args.quiet)
+    std::fprintf(stderr, "obsgroup: %zu observations: %zu in a place, %zu within %g m of one, %zu in none\n  wrote %s\n",
+                 observations.size(), inside, near, tolerance, observations.size() - inside - near,
+                 args.output.c_str());
+  return 0;
+}
+
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
+  if (args.locate) return locateObservations(args, observations, input);
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
   throwIfInterrupted(args.interrupt);
@@ -614,7 +667,15 @@ int runPartition(const PartitionArgs& args) {
   if (args.stream && args.stream->realtime && !stamped)
     throw io::UsageError("--realtime replays a CARMEN log or a ROS bag at its timestamps; " + args.input + " is " +
                          format + ", a format with no timestamps");
-  io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
+  if (args.locate) {  // fail before reading the input, not after
+    if (!std::filesystem::is_regular_file(std::filesystem::path(args.locate->places) / "places.yaml"))
+      io::readPlaceLabels(args.locate->places);  // throws the usage error that says so
+    if (std::filesystem::exists(args.output) && !args.force)
+      throw io::UsageError(args.output + " exists; --force replaces it");
+    if (std::filesystem::is_directory(args.output)) throw io::UsageError(args.output + " is a folder, not a file");
+  } else {
+    io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
+  }
   if (format == "carmen") return runCarmen(args);
   if (format == "tum-rgbd") return runDepth(args, io::DepthLayout::TumRgbd);
   if (format == "redwood") return runDepth(args, io::DepthLayout::Redwood);

@@ -25,6 +25,12 @@ struct StreamOptions {
   bool realtime = false;  ///< insert each observation at its stamp's time (logs and bags)
 };
 
+/// What `obsgroup locate` adds: the places the observations are located in.
+struct LocateOptions {
+  std::string places;      ///< the output folder of `partition` or `stream`
+  double tolerance = 1.0;  ///< metres: a pose off every place takes the nearest within this
+};
+
 struct PartitionArgs {
   std::string input;
   std::string output;
@@ -67,12 +73,16 @@ struct PartitionArgs {
   const InterruptFlag* interrupt = nullptr;
   /// Set: `obsgroup stream` (the online grouping), not `partition`.
   std::optional<StreamOptions> stream;
+  /// Set: `obsgroup locate`: `output` is the JSON file written, the method's
+  /// options are not used.
+  std::optional<LocateOptions> locate;
 };
 
 /// Runs the command; returns the exit code. Throws io::UsageError (exit 2),
 /// io::InputError (exit 3) and Interrupted.
 /// With args.stream, `obsgroup stream`: the same outputs, from the online
-/// grouping, and each change of the groups on stdout.
+/// grouping, and each change of the groups on stdout. With args.locate,
+/// `obsgroup locate`: the place of each observation, as JSON.
 int runPartition(const PartitionArgs& args);
 
 }  // namespace obsgroup::cli

@@ -1,9 +1,16 @@
 #include "place_outputs.h"
 
+#include <obsgroup/io/errors.h>
+
 #include <nlohmann/json.hpp>
 #include <png.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <optional>
+#include <cstdlib>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -177,6 +184,112 @@ void writeOccupancyPgm(const std::string& path, const PlaceMap& map) {
     out.write(row.data(), std::streamsize(row.size()));
   }
   if (!out.flush()) throw std::runtime_error(path + ": cannot write");
+}
+
+namespace {
+
+struct GreyImage {
+  png_uint_32 width = 0, height = 0;
+  int bit_depth = 0, colour_type = 0;
+};
+
+/// Reads a PNG's header and, when it is one grey channel of 8 or 16 bits,
+/// its rows into `pixels` (which the caller sized from a first call with
+/// pixels == nullptr). libpng reports errors by longjmp: nothing here needs
+/// a destructor. Returns false on a decoding error.
+bool readGreyPng(std::FILE* file, GreyImage& image, png_byte* pixels, std::size_t bytes_per_row) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  png_init_io(png, file);
+  png_read_info(png, info);
+  image.width = png_get_image_width(png, info);
+  image.height = png_get_image_height(png, info);
+  image.bit_depth = png_get_bit_depth(png, info);
+  image.colour_type = png_get_color_type(png, info);
+  if (pixels && image.colour_type == PNG_COLOR_TYPE_GRAY && (image.bit_depth == 8 || image.bit_depth == 16))
+    for (png_uint_32 r = 0; r < image.height; ++r) png_read_row(png, pixels + std::size_t(r) * bytes_per_row, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+}  // namespace
+
+PlaceMap readPlaceLabels(const std::string& folder) {
+  namespace fs = std::filesystem;
+  const fs::path yaml_path = fs::path(folder) / "places.yaml";
+  if (!fs::is_regular_file(yaml_path))
+    throw UsageError(folder + " holds no obsgroup places (no places.yaml): give the output folder of "
+                              "`obsgroup partition` or `obsgroup stream`");
+  const std::string yaml = yaml_path.string();
+  std::ifstream in(yaml);
+  std::string image;
+  std::optional<double> resolution;
+  std::optional<Eigen::Vector2d> origin;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const std::size_t colon = line.find(':');
+    if (line.empty() || line[0] == '#' || colon == std::string::npos) continue;
+    const std::string key = line.substr(0, colon);
+    std::string value = line.substr(colon + 1);
+    value.erase(0, value.find_first_not_of(' '));
+    const std::string where = yaml + ":" + std::to_string(number) + ": " + key;
+    if (key == "image") {
+      image = value;
+    } else if (key == "resolution") {
+      char* end = nullptr;
+      errno = 0;
+      const double r = std::strtod(value.c_str(), &end);
+      if (end == value.c_str() || errno == ERANGE || !(r > 0) || !std::isfinite(r))
+        throw InputError(where + ": '" + value + "' is not a resolution > 0");
+      resolution = r;
+    } else if (key == "origin") {
+      double x = 0, y = 0, yaw = 0;
+      if (std::sscanf(value.c_str(), "[%lf , %lf , %lf]", &x, &y, &yaw) != 3 || !std::isfinite(x) ||
+          !std::isfinite(y))
+        throw InputError(where + ": '" + value + "' is not [x, y, yaw]");
+      if (yaw != 0) throw InputError(where + ": a rotated map (yaw " + value + ") is not one obsgroup wrote");
+      origin = Eigen::Vector2d(x, y);
+    }
+  }
+  if (image.empty() || !resolution || !origin)
+    throw InputError(yaml + ": image, resolution and origin are required (map_server's YAML)");
+  const std::string png_path = (fs::path(folder) / image).string();
+  std::FILE* file = std::fopen(png_path.c_str(), "rb");
+  if (!file) throw InputError(png_path + ": cannot open the label map");
+  GreyImage header;
+  const bool read_header = readGreyPng(file, header, nullptr, 0);
+  if (!read_header || header.colour_type != PNG_COLOR_TYPE_GRAY || (header.bit_depth != 8 && header.bit_depth != 16) ||
+      header.width == 0 || header.height == 0 || std::size_t(header.width) * header.height > (std::size_t(1) << 31)) {
+    std::fclose(file);
+    throw InputError(png_path + ": not a one-channel 8- or 16-bit PNG label map");
+  }
+  const std::size_t bytes_per_row = std::size_t(header.width) * (header.bit_depth == 16 ? 2 : 1);
+  std::vector<png_byte> pixels(bytes_per_row * header.height);
+  std::rewind(file);
+  GreyImage again;
+  const bool read = readGreyPng(file, again, pixels.data(), bytes_per_row);
+  std::fclose(file);
+  if (!read) throw InputError(png_path + ": the PNG data are damaged");
+  PlaceMap map;
+  map.grid.resolution = *resolution;
+  map.grid.origin = *origin;
+  map.grid.width = int(header.width);
+  map.grid.height = int(header.height);
+  map.labels.assign(std::size_t(header.width) * header.height, -1);
+  for (int r = 0; r < map.grid.height; ++r) {
+    const png_byte* row = pixels.data() + std::size_t(r) * bytes_per_row;
+    const int j = map.grid.height - 1 - r;  // the top row is the grid's highest
+    for (int i = 0; i < map.grid.width; ++i) {
+      const int value = header.bit_depth == 16 ? (row[2 * i] << 8) | row[2 * i + 1] : row[i];
+      map.labels[map.grid.index(i, j)] = value - 1;
+    }
+  }
+  return map;
 }
 
 }  // namespace obsgroup::io

@@ -28,4 +28,10 @@ void writePlaceLabels(const std::string& path, const PlaceMap& map);
 /// reading of them with occupied_thresh 0.65 and free_thresh 0.196).
 void writeOccupancyPgm(const std::string& path, const PlaceMap& map);
 
+/// The label grid of an output folder (places.yaml and the image it names),
+/// what PlaceMap::locate needs; the places and doors are left empty. Throws
+/// UsageError when the folder holds no places.yaml, InputError naming the
+/// file, line and field when it or the image cannot be read.
+PlaceMap readPlaceLabels(const std::string& folder);
+
 }  // namespace obsgroup::io

@@ -101,6 +101,10 @@ void checkReach(const WorldPoints& world, const std::vector<Eigen::Vector3d>& or
 
 }  // namespace
 
+bool isPlanarData(const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensor_origins, double cell_size) {
+  return isPlanar(world, sensor_origins, cell_size);
+}
+
 Eigen::Vector3d ObservationRegions::cellCentre(std::uint64_t key) const {
   Eigen::Vector3d cell;
   if (planar) {

@@ -44,7 +44,7 @@ bool isObstacle(const Eigen::Vector3f& p, const Eigen::Vector3d& sensor, bool pl
 }
 
 GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
-                   const std::vector<Eigen::Vector3d>& sensors, const PlaceOptions& options) {
+                   const std::vector<Eigen::Vector3d>& sensors, bool planar, const PlaceOptions& options) {
   const double cs = regions.cell_size;
   GridFrame f;
   f.grid.resolution = cs;
@@ -62,7 +62,7 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
   }
   for (int i = 0; i < world.size(); ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
-      if (isObstacle(*p, sensors[i], regions.planar, options)) extend(p->x(), p->y());
+      if (isObstacle(*p, sensors[i], planar, options)) extend(p->x(), p->y());
   const Eigen::Vector2d size = cells.max() - cells.min() + Eigen::Vector2d::Ones();
   if (size.x() * size.y() > 4.0e8)
     throw std::invalid_argument("buildPlaceMap: the floor grid would have more than 400 million cells of " +
@@ -72,6 +72,42 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
   f.local_origin = base + cs * cells.min();
   f.grid.origin = Eigen::Vector2d(world.origin.x(), world.origin.y()) + f.local_origin;
   return f;
+}
+
+/// The cells a beam crosses on its way from the sensor to a point (seen from
+/// above; the point's own cell excluded), by a grid traversal (Amanatides &
+/// Woo) of every observation's every point.
+std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensors) {
+  const FloorGrid& g = f.grid;
+  std::vector<char> crossed(std::size_t(g.width) * std::size_t(g.height), 0);
+  for (int i = 0; i < world.size(); ++i) {
+    const double sx = (sensors[i].x() - f.local_origin.x()) / g.resolution;
+    const double sy = (sensors[i].y() - f.local_origin.y()) / g.resolution;
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+      const double ex = (double(p->x()) - f.local_origin.x()) / g.resolution;
+      const double ey = (double(p->y()) - f.local_origin.y()) / g.resolution;
+      int x = int(std::floor(sx)), y = int(std::floor(sy));
+      const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
+      const double dx = ex - sx, dy = ey - sy;
+      const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+      const double inf = std::numeric_limits<double>::infinity();
+      const double delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
+      double next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
+      double next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
+      const int steps = std::abs(end_x - x) + std::abs(end_y - y);
+      for (int k = 0; k < steps; ++k) {
+        if (g.contains(x, y)) crossed[g.index(x, y)] = 1;
+        if (next_x < next_y) {
+          next_x += delta_x;
+          x += step_x;
+        } else {
+          next_y += delta_y;
+          y += step_y;
+        }
+      }
+    }
+  }
+  return crossed;
 }
 
 /// Per floor cell, the group most of whose observations hold it (ties: the
@@ -464,18 +500,23 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
     throw std::invalid_argument("buildPlaceMap: every observation must be in a group");
 
   PlaceMap map;
-  const GridFrame f = makeGrid(regions, world, sensor_origins, options);
+  const bool planar = isPlanarData(world, sensor_origins, regions.cell_size);
+  const GridFrame f = makeGrid(regions, world, sensor_origins, planar, options);
   const FloorGrid& g = f.grid;
   map.grid = g;
   const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
+  // Floor is what a beam crossed and a region holds: a region model may
+  // reach where no beam went (visibility all around a forward sensor).
+  const std::vector<char> crossed = crossedCells(f, world, sensor_origins);
   map.occupancy.assign(cells, Occupancy::Unknown);
   for (std::uint64_t key : regions.cells) {
     const Eigen::Vector3d c = regions.cellCentre(key);
-    map.occupancy[g.index(f.cellX(c.x()), f.cellY(c.y()))] = Occupancy::Free;
+    const std::size_t k = g.index(f.cellX(c.x()), f.cellY(c.y()));
+    if (crossed[k]) map.occupancy[k] = Occupancy::Free;
   }
   for (int i = 0; i < n; ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
-      if (isObstacle(*p, sensor_origins[i], regions.planar, options))
+      if (isObstacle(*p, sensor_origins[i], planar, options))
         map.occupancy[g.index(f.cellX(p->x()), f.cellY(p->y()))] = Occupancy::Occupied;
 
   std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, f, group_of, map.occupancy)) : std::vector<int>{};

@@ -82,6 +82,11 @@ struct RegionParameters {
 /// Throws std::invalid_argument naming the first parameter out of range.
 void checkRegionParameters(const RegionParameters& params);
 
+/// Whether every point and sensor lies at one height (within a quarter of
+/// `cell_size`): 2D scans, which the region models treat in the plane (the
+/// visibility model's regions are plane cells in 3D too, from a height band).
+bool isPlanarData(const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensor_origins, double cell_size);
+
 inline bool operator==(const RegionParameters& a, const RegionParameters& b) {
   return a.cell_size == b.cell_size && a.max_range == b.max_range && a.clearance == b.clearance &&
          a.min_observations == b.min_observations && a.band_low == b.band_low && a.band_high == b.band_high;
