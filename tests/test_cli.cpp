@@ -110,6 +110,11 @@ nlohmann::json expectPartitionSchema(const fs::path& out, std::size_t observatio
   EXPECT_EQ(p.at("parameters").contains("cell"), !points);
   EXPECT_EQ(p.at("parameters").contains("range"), !points);
   EXPECT_TRUE(p.at("input").is_string());
+  // Every observation traceable to its source (and its stamp, where the format has one).
+  EXPECT_EQ(p.at("sources").size(), observations);
+  for (const auto& source : p.at("sources")) EXPECT_FALSE(source.get<std::string>().empty());
+  EXPECT_TRUE(p.at("stamps").is_null() || p.at("stamps").size() == observations);
+  EXPECT_EQ(p.at("place_ids").size(), p.at("groups").size());
   for (const char* key : {"load", "overlap", "graph", "partition", "outputs"})
     EXPECT_TRUE(p.at("timing_s").at(key).is_number()) << key;
   return p;
@@ -1147,6 +1152,33 @@ TEST_F(Cli, ATruncatedLastLineIsAnErrorUnlessBadLinesAreSkipped) {
   const auto p = readJson(dir_ / "k" / "partition.json");
   EXPECT_EQ(p.at("observations"), 23);
   EXPECT_EQ(run("partition " + kData + "/office_3d/pcd --skip-bad-lines -o " + (dir_ / "x").string()).code, 2);
+
+  // A bad line in the middle shifts no observation silently: each names its line.
+  std::istringstream lines(log);
+  std::string text, line;
+  int bad_line = 0;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    if (bad_line == 0 && number > 5 && line.rfind("ROBOTLASER1", 0) == 0) {
+      bad_line = number;
+      line = "ROBOTLASER1 not a number";
+    }
+    text += line + "\n";
+  }
+  writeFile(dir_ / "middle.clf", text);
+  const Result middle = run("partition " + (dir_ / "middle.clf").string() + " --skip-bad-lines --no-pictures -o " +
+                            (dir_ / "m").string());
+  ASSERT_EQ(middle.code, 0) << middle.err;
+  const auto m = readJson(dir_ / "m" / "partition.json");
+  ASSERT_EQ(m.at("sources").size(), m.at("observations").get<std::size_t>());
+  int previous = 0;
+  for (const auto& source : m.at("sources")) {
+    const std::string s = source;
+    const int number = std::stoi(s.substr(s.rfind(':') + 1));
+    EXPECT_NE(number, bad_line) << s;
+    EXPECT_GT(number, previous) << s;
+    previous = number;
+  }
+  EXPECT_EQ(m.at("stamps").size(), m.at("observations").get<std::size_t>());
 }
 
 TEST_F(Cli, APoseFormatWithoutAPosesFileIsRefused) {

@@ -348,6 +348,8 @@ io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, con
                          {"kept_members", maps.refinement.members - maps.refinement.moved}});
   run.warnings = warn.all();
   run.place_ids = grouped.place_ids;
+  run.sources = input.labels;
+  run.stamps = input.stamps;
   run.timing_s = grouped.timing_s;
   run.timing_s.update({{"load", input.load_s},
                        {"local_maps", maps.seconds},

@@ -80,6 +80,8 @@ std::string partitionJson(const Partition& partition, const RunRecord& run) {
       << "  \"observations\": " << partition.group_of.size() << ",\n"
       << "  \"groups\": " << arrayPerLine(partition.groups.size(), group) << ",\n"
       << "  \"place_ids\": " << nlohmann::json(run.place_ids).dump() << ",\n"
+      << "  \"sources\": " << nlohmann::json(run.sources).dump() << ",\n"
+      << "  \"stamps\": " << (run.stamps.empty() ? nlohmann::json() : nlohmann::json(run.stamps)).dump() << ",\n"
       << "  \"splits\": " << arrayPerLine(partition.splits.size(), split) << ",\n"
       << "  \"parameters\": " << run.parameters.dump() << ",\n"
       << "  \"statistics\": " << run.statistics.dump() << ",\n"

@@ -22,9 +22,15 @@ struct RunRecord {
   /// The place id of each group, in group order (places.json's ids): the
   /// group's index for `partition`, the online grouping's stable id for `stream`.
   std::vector<int> place_ids;
+  /// Where each observation came from (a log's file and line, a PCD or image
+  /// file, a bag's message), and when it was sensed (empty: the format has
+  /// no stamps), in observation order.
+  std::vector<std::string> sources;
+  std::vector<double> stamps;
 };
 
-/// {"observations": N, "groups": [[...]], "place_ids": [...], "splits": [...], "parameters": {...},
+/// {"observations": N, "groups": [[...]], "place_ids": [...], "sources": [...],
+///  "stamps": [...] or null, "splits": [...], "parameters": {...},
 ///  "statistics": {...}, "warnings": [...], "input": "...", "timing_s": {...}}, keys in this order,
 /// one group and one split per line.
 std::string partitionJson(const Partition& partition, const RunRecord& run);
