@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -166,6 +167,15 @@ void expectPlaces(const fs::path& out, const nlohmann::json& partition) {
   EXPECT_EQ(pgm.substr(0, header.size()), header);
   EXPECT_EQ(pgm.size(), header.size() + grid.at("width").get<std::size_t>() * grid.at("height").get<std::size_t>());
   EXPECT_NE(readFile(out / "occupancy.yaml").find("image: occupancy.pgm\n"), std::string::npos);
+  // The labelled whole map reloads in PCL with the place ids as labels.
+  pcl::PointCloud<pcl::PointXYZL> labelled;
+  ASSERT_EQ(pcl::io::loadPCDFile((out / "map_labelled.pcd").string(), labelled), 0);
+  EXPECT_EQ(labelled.size(), partition.at("statistics").at("local_map_points").get<std::size_t>());
+  const std::set<int> id_set = ids.get<std::set<int>>();
+  std::set<int> labels;
+  for (const auto& p : labelled.points) labels.insert(int(p.label));
+  EXPECT_TRUE(std::includes(id_set.begin(), id_set.end(), labels.begin(), labels.end()));
+  EXPECT_FALSE(labels.empty());
 }
 
 void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {

@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <type_traits>
 
 namespace obsgroup::io {
 
@@ -31,8 +32,57 @@ std::size_t writeLocalMaps(const OutputFolder& out, const std::vector<LocalMap<P
   return total;
 }
 
+namespace {
+
+/// The labelled point of a map's point moved to the world frame.
+template <typename PointT>
+auto labelledPoint(const PointT& p, const Eigen::Isometry3f& pose, std::uint32_t label) {
+  const Eigen::Vector3f q = pose * p.getVector3fMap();
+  if constexpr (std::is_same_v<PointT, pcl::PointXYZRGB>) {
+    pcl::PointXYZRGBL out;
+    out.x = q.x(), out.y = q.y(), out.z = q.z();
+    out.rgba = p.rgba;
+    out.label = label;
+    return out;
+  } else {
+    pcl::PointXYZL out;
+    out.x = q.x(), out.y = q.y(), out.z = q.z();
+    out.label = label;
+    return out;
+  }
+}
+
+}  // namespace
+
+template <typename PointT>
+std::size_t writeLabelledMap(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps,
+                             const std::vector<int>& place_ids) {
+  using Labelled = decltype(labelledPoint(PointT{}, Eigen::Isometry3f::Identity(), 0));
+  pcl::PointCloud<Labelled> cloud;
+  std::size_t total = 0;
+  for (const auto& map : maps) total += map.cloud->size();
+  cloud.reserve(total);
+  for (std::size_t g = 0; g < maps.size(); ++g) {
+    const Eigen::Isometry3f pose = maps[g].frame.pose.template cast<float>();
+    const auto label = std::uint32_t(place_ids.at(g));
+    for (const PointT& p : maps[g].cloud->points) cloud.push_back(labelledPoint(p, pose, label));
+  }
+  out.write("map_labelled.pcd", [&cloud](const std::string& temporary) {
+    const int status = cloud.empty() ? pcl::io::savePCDFileASCII(temporary, cloud)
+                                     : pcl::io::savePCDFileBinaryCompressed(temporary, cloud);
+    if (status < 0) throw std::runtime_error(temporary + ": cannot write");
+  });
+  return cloud.size();
+}
+
 template std::size_t writeLocalMaps(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int);
 template std::size_t writeLocalMaps(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&, int);
 template std::size_t writeLocalMaps(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int);
+template std::size_t writeLabelledMap(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&,
+                                      const std::vector<int>&);
+template std::size_t writeLabelledMap(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZI>>&,
+                                      const std::vector<int>&);
+template std::size_t writeLabelledMap(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZRGB>>&,
+                                      const std::vector<int>&);
 
 }  // namespace obsgroup::io

@@ -15,4 +15,12 @@ namespace obsgroup::io {
 template <typename PointT>
 std::size_t writeLocalMaps(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0);
 
+/// map_labelled.pcd: every local map's points at its reference's pose in
+/// the world frame, each labelled with its place id (`place_ids`, in map
+/// order): pcl::PointXYZL, or PointXYZRGBL for coloured input. Each map is
+/// voxel-filtered already; returns the points written.
+template <typename PointT>
+std::size_t writeLabelledMap(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps,
+                             const std::vector<int>& place_ids);
+
 }  // namespace obsgroup::io

@@ -306,6 +306,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   const auto start = Clock::now();
   OutputTimes t;
   t.map_points = io::writeLocalMaps(out, maps.maps, args.method.threads);
+  io::writeLabelledMap(out, maps.maps, grouped.place_ids);
   out.writeText("topology.json", io::topologyJson(maps.topology));
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
