@@ -396,6 +396,7 @@ void drawGroupMarks(cairo_t* cr, const MapLayout& layout, const MarkSizes& sizes
 struct LegendText {
   std::size_t observations = 0, groups = 0, numbered = 0, arcs = 0, shown_arcs = 0, outside = 0;
   bool regions = false;
+  bool places = false;
 };
 
 /// The legend's first row, at `row`: a group's circle, a dot (when some
@@ -448,7 +449,8 @@ void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendTex
     std::snprintf(outside, sizeof outside, "; %zu far point%s outside the picture", t.outside,
                   t.outside == 1 ? "" : "s");
   std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered); neighbouring groups differ in"
-                " colour%s", t.observations, t.groups, t.numbered, outside);
+                " colour%s%s", t.observations, t.groups, t.numbered,
+                t.places ? "; lines: each place's floor, black bars: doors (places.json)" : "", outside);
   text(cr, x0, row + 24, caption, 12);
 }
 
@@ -464,7 +466,6 @@ void drawLegend(cairo_t* cr, const MapLayout& layout, const LegendText& t, const
 }
 
 
-/// The picture over `points` (the rasterised points), without the legend.
 /// Each place's outline in its group's darker colour, each door a black bar
 /// (the places are in the world frame; the view is re-centred on `origin`).
 void drawPlaces(cairo_t* cr, const MapLayout& layout, const PlaceMap& places, const Eigen::Vector3d& origin) {
@@ -494,6 +495,7 @@ void drawPlaces(cairo_t* cr, const MapLayout& layout, const PlaceMap& places, co
   cairo_stroke(cr);
 }
 
+/// The picture over `points` (the rasterised points), with its legend.
 void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
              const std::vector<Eigen::Vector2d>& positions, const std::vector<double>& headings,
              const Partition& partition, const TopologicalMap& topology, bool regions, const PlaceMap* places,
@@ -515,6 +517,7 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
   legend.shown_arcs = layout.shown_arcs.size();
   legend.outside = layout.points_outside;
   legend.regions = regions;
+  legend.places = places != nullptr;
   drawLegend(cr, layout, legend, sizes);
 }
 
