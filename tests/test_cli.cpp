@@ -1606,3 +1606,40 @@ TEST_F(Cli, LocateFindsEachObservationsPlaceAndRefusesWhatItCannotUse) {
   EXPECT_EQ(damaged.code, 3);
   EXPECT_NE(damaged.err.find("places.png"), std::string::npos) << damaged.err;
 }
+
+TEST_F(Cli, LocateAlignsAnOffsetRunToItsPlacesLocalMaps) {
+  // Run 1 at the true poses; run 2 the same depth frames with every pose 0.29 m off.
+  const fs::path run1 = dir_ / "run1";
+  ASSERT_EQ(run("partition " + kData + "/office_3d/pcd --poses " + kData + "/office_3d/poses.txt -q --no-pictures -o " +
+                run1.string()).code, 0);
+  std::ifstream in(kData + "/office_3d/poses.txt");
+  std::ofstream off(dir_ / "poses_off.txt");
+  std::vector<Eigen::Vector2d> truth;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double t, x, y, z, qx, qy, qz, qw;
+    fields >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
+    truth.emplace_back(x, y);
+    off << std::setprecision(12) << t << " " << x + 0.25 << " " << y - 0.15 << " " << z << " " << qx << " " << qy << " "
+        << qz << " " << qw << "\n";
+  }
+  off.close();
+  const fs::path located = dir_ / "located.json";
+  const Result r = run("locate " + run1.string() + " " + kData + "/office_3d/pcd --poses " +
+                       (dir_ / "poses_off.txt").string() + " --align -o " + located.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<double> errors;
+  const nlohmann::json locations = readJson(located);
+  for (const auto& l : locations.at("locations")) {
+    ASSERT_TRUE(l.contains("converged")) << l.dump();
+    if (!l.at("converged").get<bool>()) continue;
+    EXPECT_TRUE(l.at("fitness_m2").is_number());
+    const auto& pose = l.at("aligned_pose");
+    const Eigen::Vector2d at(pose.at("x").get<double>(), pose.at("y").get<double>());
+    errors.push_back((at - truth.at(l.at("observation").get<std::size_t>())).norm());
+  }
+  ASSERT_GE(errors.size(), 0.9 * truth.size()) << r.err;
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.1) << "median error of the aligned poses";  // 0.29 m before
+}

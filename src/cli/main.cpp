@@ -251,6 +251,9 @@ void addLocateOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, obs
                      "a pose on no place takes the nearest place within this, metres (0: none)")
       ->check(finiteNumber(0.0))
       ->capture_default_str();
+  command.add_flag("--align", locate.align,
+                   "align each located observation to its place's local map (ICP from its pose) and report the "
+                   "aligned pose, its place and the fit");
   command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
       ->check(wholeNumber(0))
       ->capture_default_str();

@@ -19,9 +19,14 @@
 #include <obsgroup/maps/topological_map.h>
 #include <obsgroup/common/parallel_for.h>
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/io/pose_file.h>
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
+#include <pcl/common/io.h>
+#include <pcl/filters/filter.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/registration/icp.h>
 
 #include <algorithm>
 #include <charconv>
@@ -397,6 +402,10 @@ void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std
   printWritten(args);
 }
 
+/// ICP's correspondence gate for `locate --align`, metres: the pose error
+/// of a second run in a map's frame that alignment can correct.
+constexpr double kAlignMaxCorrespondence = 0.5;
+
 /// Writes `text` to `path` through a temporary file beside it, so that the
 /// file is whole or absent; an existing file is replaced only with --force.
 void writeFileAtomically(const std::string& path, const std::string& text) {
@@ -414,6 +423,83 @@ void writeFileAtomically(const std::string& path, const std::string& text) {
   }
 }
 
+/// The local maps of an output folder, for `locate --align`: each place's
+/// map cloud and its reference's pose, loaded when first asked for.
+template <typename PointT>
+class PlaceLocalMaps {
+ public:
+  explicit PlaceLocalMaps(const std::string& folder) : folder_(folder) {
+    const std::string partition_path = folder + "/partition.json";
+    try {
+      const nlohmann::json partition = nlohmann::json::parse(io::readInputBytes(partition_path, "partition.json"));
+      const auto& ids = partition.at("place_ids");
+      for (std::size_t g = 0; g < ids.size(); ++g) group_of_place_[ids[g].get<int>()] = g;
+    } catch (const nlohmann::json::exception& e) {
+      throw io::InputError(partition_path + ": no place_ids (" + e.what() + ")");
+    }
+    const std::string poses_path = folder + "/local_maps/poses.txt";
+    poses_ = io::parsePoses(io::readInputBytes(poses_path, "local map poses"), poses_path, io::PoseFormat::Tum);
+    clouds_.resize(poses_.size());
+  }
+
+  /// The local map of place `id` and its reference's pose; null when the
+  /// folder has none for it.
+  std::pair<typename pcl::PointCloud<PointT>::ConstPtr, Eigen::Isometry3d> of(int id) {
+    const auto it = group_of_place_.find(id);
+    if (it == group_of_place_.end() || it->second >= poses_.size()) return {nullptr, Eigen::Isometry3d::Identity()};
+    const std::size_t g = it->second;
+    if (!clouds_[g]) {
+      char name[64];
+      std::snprintf(name, sizeof name, "/local_maps/group_%03zu.pcd", g);
+      typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+      if (pcl::io::loadPCDFile(folder_ + name, *cloud) < 0) throw io::InputError(folder_ + name + ": cannot read");
+      clouds_[g] = cloud;
+    }
+    return {clouds_[g], poses_[g]};
+  }
+
+ private:
+  std::string folder_;
+  std::map<int, std::size_t> group_of_place_;
+  std::vector<Eigen::Isometry3d> poses_;
+  std::vector<typename pcl::PointCloud<PointT>::ConstPtr> clouds_;
+};
+
+nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"qw", q.w()}, {"qx", q.x()}, {"qy", q.y()}, {"qz", q.z()}};
+}
+
+/// An observation aligned to its place's local map by PCL's ICP, from its
+/// input pose: the aligned pose in the world, whether ICP converged, and
+/// its fitness (mean squared distance of the matched points, m^2).
+template <typename PointT>
+nlohmann::json alignToPlace(const Observation<PointT>& observation, const pcl::PointCloud<PointT>& map,
+                            const Eigen::Isometry3d& map_pose, Eigen::Isometry3d& aligned) {
+  typename pcl::PointCloud<PointT>::Ptr source(new pcl::PointCloud<PointT>);
+  pcl::copyPointCloud(*observation.cloud, *source);
+  source->is_dense = false;
+  std::vector<int> kept;
+  pcl::removeNaNFromPointCloud(*source, *source, kept);
+  typename pcl::PointCloud<PointT>::Ptr target(new pcl::PointCloud<PointT>(map));
+  if (source->empty() || target->size() < 3) return {{"converged", false}, {"fitness_m2", nullptr}};
+  pcl::IterativeClosestPoint<PointT, PointT> icp;
+  icp.setInputSource(source);
+  icp.setInputTarget(target);
+  icp.setMaxCorrespondenceDistance(kAlignMaxCorrespondence);
+  icp.setMaximumIterations(50);
+  icp.setTransformationEpsilon(1e-8);
+  pcl::PointCloud<PointT> moved;
+  const Eigen::Isometry3d guess = map_pose.inverse() * observation.pose;  // the observation in the map's frame
+  icp.align(moved, guess.matrix().cast<float>());
+  if (!icp.hasConverged()) return {{"converged", false}, {"fitness_m2", nullptr}};
+  Eigen::Isometry3d found(icp.getFinalTransformation().template cast<double>());
+  found.linear() = Eigen::Quaterniond(found.rotation()).normalized().toRotationMatrix();  // ICP works in float
+  aligned = map_pose * found;
+  return {{"converged", true}, {"fitness_m2", icp.getFitnessScore(kAlignMaxCorrespondence)}};
+}
+
 /// `obsgroup locate`: each observation's place in the places of a run.
 template <typename PointT>
 int locateObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
@@ -421,30 +507,47 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
   const PlaceMap places = io::readPlaceLabels(args.locate->places);
+  std::optional<PlaceLocalMaps<PointT>> maps;
+  if (args.locate->align) maps.emplace(args.locate->places);
   const double tolerance = args.locate->tolerance;
   std::string text = "{\"places\": " + nlohmann::json(args.locate->places).dump() +
                      ", \"tolerance_m\": " + nlohmann::json(tolerance).dump() + ",\n \"locations\": [";
-  std::size_t inside = 0, near = 0;
+  std::size_t inside = 0, near = 0, converged = 0;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     throwIfInterrupted(args.interrupt);
     const Eigen::Vector2d position = observations[i].pose.translation().template head<2>();
     const Location at = places.locate(position, tolerance);
     inside += at.place && at.distance_m == 0;
     near += at.place && at.distance_m > 0;
-    const nlohmann::json line = {
+    nlohmann::json line = {
         {"observation", i},
         {"source", input.labels.at(i)},
         {"stamp", input.stamps.empty() ? nlohmann::json() : nlohmann::json(input.stamps[i])},
         {"place", at.place ? nlohmann::json(*at.place) : nlohmann::json()},
         {"distance_m", at.place ? nlohmann::json(at.distance_m) : nlohmann::json()}};
+    if (maps && at.place) {
+      const auto [map, map_pose] = maps->of(*at.place);
+      Eigen::Isometry3d aligned = observations[i].pose;
+      nlohmann::json fit = map ? alignToPlace(observations[i], *map, map_pose, aligned)
+                               : nlohmann::json{{"converged", false}, {"fitness_m2", nullptr}};
+      if (fit.at("converged").get<bool>()) {
+        ++converged;
+        const Location again = places.locate(aligned.translation().head<2>(), tolerance);
+        fit["aligned_pose"] = poseJson(aligned);
+        fit["aligned_place"] = again.place ? nlohmann::json(*again.place) : nlohmann::json();
+      }
+      line.update(fit);
+    }
     text += (i ? ",\n  " : "\n  ") + line.dump();
   }
   text += observations.empty() ? "]}\n" : "\n ]}\n";
   writeFileAtomically(args.output, text);
-  if (!args.quiet)
-    std::fprintf(stderr, "obsgroup: %zu observations: %zu in a place, %zu within %g m of one, %zu in none\n  wrote %s\n",
-                 observations.size(), inside, near, tolerance, observations.size() - inside - near,
-                 args.output.c_str());
+  if (!args.quiet) {
+    std::fprintf(stderr, "obsgroup: %zu observations: %zu in a place, %zu within %g m of one, %zu in none\n",
+                 observations.size(), inside, near, tolerance, observations.size() - inside - near);
+    if (maps) std::fprintf(stderr, "  %zu of %zu aligned to their place's local map\n", converged, inside + near);
+    std::fprintf(stderr, "  wrote %s\n", args.output.c_str());
+  }
   return 0;
 }
 

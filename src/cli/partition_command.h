@@ -29,6 +29,9 @@ struct StreamOptions {
 struct LocateOptions {
   std::string places;      ///< the output folder of `partition` or `stream`
   double tolerance = 1.0;  ///< metres: a pose off every place takes the nearest within this
+  /// Align each located observation to its place's local map (PCL's ICP)
+  /// and report the aligned pose, its place and the fit.
+  bool align = false;
 };
 
 struct PartitionArgs {
