@@ -686,6 +686,10 @@ TEST_F(Cli, UsageMessagesSayWhatIsWrong) {
   };
   expectUsage("", "a command is required: partition");
   expectUsage("partiton " + input + out, "unknown command 'partiton' (commands: partition, stream, locate)");
+  // A misspelt option is named, with the nearest the command has.
+  expectUsage("partition " + input + out + " --refin lum", "unknown option '--refin' (did you mean --refine?)");
+  expectUsage("stream " + input + out + " --updat-every 2", "unknown option '--updat-every' (did you mean --update-every?)");
+  expectUsage("locate " + input + " " + input + out + " --xyzzy", "unknown option '--xyzzy' (obsgroup locate --help lists the options)");
   expectUsage("partition " + input + out + " --sso points --delta 0", "--delta: must be > 0 (got 0)");
   expectUsage("partition " + input + out + " --sso points --delta 0.2cm", "'0.2cm' is not a number");
   expectUsage("partition " + input + out + " --sso points --delta nan", "'nan' is not a finite number");

@@ -13,11 +13,14 @@
 
 #include <signal.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -301,6 +304,55 @@ std::optional<std::string> commandError(int argc, char** argv, const CLI::App& a
   return "unknown command '" + first + "' (commands: " + names + ")";
 }
 
+/// Edit distance (insertions, deletions, substitutions) between two words.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+/// An option the command does not have, checked before CLI11 parses (it
+/// says only that "lum --refin" were not expected): named, with the nearest
+/// option the command has when one is close.
+std::optional<std::string> unknownOptionError(int argc, char** argv, const CLI::App& app) {
+  if (argc < 2) return std::nullopt;
+  const CLI::App* command = nullptr;
+  for (const CLI::App* c : app.get_subcommands({}))
+    if (c->get_name() == argv[1]) command = c;
+  if (!command) return std::nullopt;
+  std::vector<std::string> names{"--help", "-h"};
+  for (const CLI::Option* option : command->get_options()) {
+    for (const std::string& l : option->get_lnames()) names.push_back("--" + l);
+    for (const std::string& n : option->get_snames()) names.push_back("-" + n);
+  }
+  for (int a = 2; a < argc; ++a) {
+    std::string word = argv[a];
+    if (word == "--") break;  // the rest are arguments
+    if (word.size() < 2 || word[0] != '-' || std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.')
+      continue;  // an argument, "-" (standard input) or a negative number
+    word = word.substr(0, word.find('='));
+    if (std::find(names.begin(), names.end(), word) != names.end()) continue;
+    std::string nearest;
+    std::size_t best = std::string::npos;
+    for (const std::string& name : names)
+      if (name.size() > 2 && editDistance(word, name) < best) best = editDistance(word, name), nearest = name;
+    const std::string hint = best <= std::max<std::size_t>(2, word.size() / 3)
+                                 ? "did you mean " + nearest + "?"
+                                 : "obsgroup " + command->get_name() + " --help lists the options";
+    return "unknown option '" + word + "' (" + hint + ")";
+  }
+  return std::nullopt;
+}
+
 /// --pose-format without a poses file: a mistake whatever the command.
 bool poseFormatWithoutPoses(const CLI::App& command, const obsgroup::cli::PartitionArgs& args) {
   return command.count("--pose-format") && !args.poses;
@@ -380,6 +432,7 @@ int main(int argc, char** argv) {
     return 2;
   };
   if (const auto error = commandError(argc, argv, app)) return usage(*error);
+  if (const auto error = unknownOptionError(argc, argv, app)) return usage(*error);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
