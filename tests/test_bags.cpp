@@ -201,7 +201,16 @@ TEST_F(Ros1Bag, WithoutAMapFrameThePosesAreInOdomWithAWarning) {
   EXPECT_NE(read.warnings[0].find("'odom'"), std::string::npos);
   BagOptions options;
   options.fixed_frame = "world";
-  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); }, {"no frame 'world'", "--fixed-frame"}));
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"no frame 'world'", "--fixed-frame", "its frames: ", "'odom'"}));
+  // The sensor's own frame as the fixed frame would make every pose the identity.
+  options.fixed_frame = "laser";
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"'laser' is the sensor's own frame", "--fixed-frame"}));
+  // A topic named without its leading slash is found.
+  options = BagOptions{};
+  options.topic = "scan";
+  EXPECT_EQ(loadBag(path(), BagVersion::Ros1, options).topic, "/scan");
 }
 
 TEST_F(Ros1Bag, APoseTopicMovesTheBodyAndTfStaticMountsTheSensor) {
@@ -236,6 +245,8 @@ TEST_F(Ros1Bag, APoseTopicMovesTheBodyAndTfStaticMountsTheSensor) {
   expectPose(odom.observations[0].pose, planar(0.5, 0, 0) * planar(0.2, 0.1, M_PI));
   // PoseStamped carries no child frame: the pose is that of the root of the
   // sensor's /tf_static chain (base_link).
+  options.pose_topic = "odom";  // without the slash
+  EXPECT_EQ(loadBag(path(), BagVersion::Ros1, options).pose_source, "/odom");
   options.pose_topic = "/slam_pose";
   const BagSequence slam = loadBag(path(), BagVersion::Ros1, options);
   EXPECT_EQ(slam.fixed_frame, "map");

@@ -165,6 +165,22 @@ class FrameTree {
 
   bool has(const std::string& frame) const { return frames_.count(frame) > 0; }
   bool hasParent(const std::string& frame) const { return edges_.count(frame) > 0; }
+  /// "a, b, c": every frame of the tree, for messages.
+  std::string frameList() const {
+    std::string list;
+    for (const auto& f : frames_) list += (list.empty() ? "'" : ", '") + f + "'";
+    return list;
+  }
+  /// Whether `frame` is `ancestor` or hangs below it.
+  bool isAtOrBelow(std::string frame, const std::string& ancestor) const {
+    for (std::size_t depth = 0; depth <= edges_.size(); ++depth) {
+      if (frame == ancestor) return true;
+      const auto e = edges_.find(frame);
+      if (e == edges_.end()) return false;
+      frame = e->second.parent;
+    }
+    return false;
+  }
   /// The topmost ancestor of `frame` through /tf_static edges only.
   std::string staticRoot(std::string frame) const {
     for (auto e = edges_.find(frame); e != edges_.end() && e->second.fixed; e = edges_.find(frame))
@@ -259,9 +275,14 @@ std::string topicList(const std::vector<bag::Topic>& topics) {
   return list;
 }
 
+/// The topic named `name`, or `/name` when the user left out the leading
+/// slash (`--topic scan` for /scan).
 const bag::Topic* findTopic(const std::vector<bag::Topic>& topics, const std::string& name) {
   for (const auto& t : topics)
     if (t.name == name) return &t;
+  if (!name.empty() && name[0] != '/')
+    for (const auto& t : topics)
+      if (t.name == "/" + name) return &t;
   return nullptr;
 }
 
@@ -289,12 +310,14 @@ const bag::Topic& chooseDataTopic(const std::vector<bag::Topic>& topics, const s
   return *data.front();
 }
 
-void checkPoseTopic(const std::vector<bag::Topic>& topics, const std::string& asked, const std::string& bag_name) {
+/// The pose topic's name as the bag spells it; throws when it is not one.
+std::string checkPoseTopic(const std::vector<bag::Topic>& topics, const std::string& asked, const std::string& bag_name) {
   const bag::Topic* topic = findTopic(topics, asked);
   if (!topic) throw InputError(bag_name + ": no topic " + asked + " (--pose-topic); " + topicList(topics));
   if (topic->type != bag::kOdometryType && topic->type != bag::kPoseStampedType)
     throw InputError(bag_name + ": topic " + asked + " is a " + topic->type +
                      ", not a nav_msgs/Odometry or geometry_msgs/PoseStamped (--pose-topic)");
+  return topic->name;
 }
 
 /// A scan's returns as points in its frame (x ahead, y left): finite ranges
@@ -391,6 +414,7 @@ class PoseSource {
     if (options.fixed_frame || !tree_.has("odom"))
       throw InputError(bag_name + ": /tf has no frame '" + fixed_frame_ + "'" +
                        (options.fixed_frame ? std::string(" (--fixed-frame)") : " nor 'odom'") +
+                       "; its frames: " + tree_.frameList() +
                        "; give the frame the poses are in with --fixed-frame, or a pose topic with --pose-topic");
     warnings_.push_back(bag_name + ": /tf has no 'map' frame: the poses are taken in 'odom' (odometry, which drifts)");
     fixed_frame_ = "odom";
@@ -405,6 +429,11 @@ class PoseSource {
     if (description_ == "/tf") {
       if (!tree_.connected(fixed_frame_, sensor))
         throw InputError(context + ": /tf does not connect the sensor's frame '" + sensor + "' to '" + fixed_frame_ + "'");
+      if (tree_.isAtOrBelow(fixed_frame_, sensor))
+        throw InputError(context + ": the fixed frame '" + fixed_frame_ + "' " +
+                         (fixed_frame_ == sensor ? std::string("is the sensor's own frame") : "moves with the sensor ('" + sensor + "')") +
+                         ": every pose would be the same; give the frame the robot moves in with --fixed-frame (the bag's "
+                         "frames: " + tree_.frameList() + ")");
       return tree_.lookup(fixed_frame_, sensor, stamp);
     }
     const auto body = track_.at(stamp);
@@ -526,8 +555,10 @@ BagReader::BagReader(const std::string& path, BagVersion version, const BagOptio
   const bool ros1 = version == BagVersion::Ros1;
   c.topics = ros1 ? bag::listRos1Topics(path) : bag::listRos2Topics(path);
   c.data = chooseDataTopic(c.topics, options.topic, path);
-  if (options.pose_topic) checkPoseTopic(c.topics, *options.pose_topic, path);
-  const bag::Request request{c.data.name, options.pose_topic, !options.poses_file};
+  // The topics as the bag spells them (a name given without its leading slash).
+  c.options.topic = c.data.name;
+  if (options.pose_topic) c.options.pose_topic = checkPoseTopic(c.topics, *options.pose_topic, path);
+  const bag::Request request{c.data.name, c.options.pose_topic, !options.poses_file};
   c.messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
 }
 
