@@ -1,5 +1,7 @@
 #include "obsgroup/places/place_map.h"
 
+#include "obsgroup/common/parallel_for.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -110,47 +112,52 @@ std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, con
   return crossed;
 }
 
-/// Per floor cell, the group most of whose observations hold it (ties: the
-/// lower group), or kNone.
-std::vector<int> ownerOfCells(const ObservationRegions& regions, const GridFrame& f, const std::vector<int>& group_of,
-                              const std::vector<Occupancy>& occupancy) {
-  std::vector<std::pair<std::uint32_t, int>> held;  // (cell index, group), once per observation
-  held.reserve(regions.cells.size());
-  std::vector<std::uint32_t> own;
-  for (int i = 0; i < regions.size(); ++i) {
-    own.clear();
+/// The grid cell of every region cell (regions.cells' order; 3D voxels
+/// fall on the cell below them).
+std::vector<std::uint32_t> gridCellsOfRegions(const ObservationRegions& regions, const GridFrame& f) {
+  std::vector<std::uint32_t> index(regions.cells.size());
+  parallelFor(std::size_t(regions.size()), 0, 16, [&](std::size_t i) {
     for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
       const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
-      const int x = f.cellX(c.x()), y = f.cellY(c.y());
-      if (f.grid.contains(x, y)) own.push_back(std::uint32_t(f.grid.index(x, y)));
+      index[k] = std::uint32_t(f.grid.index(f.cellX(c.x()), f.cellY(c.y())));
     }
-    std::sort(own.begin(), own.end());
-    own.erase(std::unique(own.begin(), own.end()), own.end());  // 3D voxels seen from above
-    for (std::uint32_t cell : own) held.emplace_back(cell, group_of[i]);
-  }
-  std::sort(held.begin(), held.end());
-  std::vector<std::size_t> group_size;
-  for (int g : group_of) {
-    if (g >= int(group_size.size())) group_size.resize(std::size_t(g) + 1, 0);
-    ++group_size[std::size_t(g)];
-  }
-  std::vector<int> owner(occupancy.size(), kNone);
-  for (std::size_t a = 0; a < held.size();) {
-    int best = kNone;
-    std::size_t best_count = 0;
-    std::size_t b = a;
-    while (b < held.size() && held[b].first == held[a].first) {
-      std::size_t e = b;
-      while (e < held.size() && held[e] == held[b]) ++e;
-      // The largest share of a group's observations, compared exactly:
-      // count / size > best_count / best_size.
-      const std::size_t g = std::size_t(held[b].second);
-      if (best == kNone || (e - b) * group_size[std::size_t(best)] > best_count * group_size[g])
-        best = held[b].second, best_count = e - b;
-      b = e;
+  });
+  return index;
+}
+
+/// Per floor cell, the group the largest share of whose observations hold
+/// it (ties: the lower group), or kNone. Groups are taken in order, each
+/// counting its observations per cell once (a 3D region's voxels above one
+/// cell count once), so no sort of all the cells is needed.
+std::vector<int> ownerOfCells(const ObservationRegions& regions, const std::vector<std::uint32_t>& cell_of,
+                              const std::vector<std::vector<int>>& groups, const std::vector<Occupancy>& occupancy) {
+  const std::size_t cells = occupancy.size();
+  std::vector<int> owner(cells, kNone);
+  std::vector<std::uint32_t> best_count(cells, 0), count(cells, 0), seen_by(cells, 0);
+  std::vector<std::uint32_t> touched;
+  std::uint32_t stamp = 0;  // which observation last counted a cell (its position + 1)
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    touched.clear();
+    for (int i : groups[g]) {
+      ++stamp;
+      for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
+        const std::uint32_t c = cell_of[k];
+        if (seen_by[c] == stamp) continue;  // another voxel of this observation above the cell
+        seen_by[c] = stamp;
+        if (count[c]++ == 0) touched.push_back(c);
+      }
     }
-    if (occupancy[held[a].first] == Occupancy::Free) owner[held[a].first] = best;
-    a = b;
+    const std::uint64_t size = groups[g].size();
+    for (std::uint32_t c : touched) {
+      // count / size > best_count / best_size, compared exactly.
+      if (occupancy[c] == Occupancy::Free &&
+          (owner[c] == kNone ||
+           std::uint64_t(count[c]) * groups[std::size_t(owner[c])].size() > std::uint64_t(best_count[c]) * size)) {
+        owner[c] = int(g);
+        best_count[c] = count[c];
+      }
+      count[c] = 0;
+    }
   }
   return owner;
 }
@@ -508,18 +515,16 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   // Floor is what a beam crossed and a region holds: a region model may
   // reach where no beam went (visibility all around a forward sensor).
   const std::vector<char> crossed = crossedCells(f, world, sensor_origins);
+  const std::vector<std::uint32_t> cell_of = gridCellsOfRegions(regions, f);
   map.occupancy.assign(cells, Occupancy::Unknown);
-  for (std::uint64_t key : regions.cells) {
-    const Eigen::Vector3d c = regions.cellCentre(key);
-    const std::size_t k = g.index(f.cellX(c.x()), f.cellY(c.y()));
+  for (std::uint32_t k : cell_of)
     if (crossed[k]) map.occupancy[k] = Occupancy::Free;
-  }
   for (int i = 0; i < n; ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
       if (isObstacle(*p, sensor_origins[i], planar, options))
         map.occupancy[g.index(f.cellX(p->x()), f.cellY(p->y()))] = Occupancy::Occupied;
 
-  std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, f, group_of, map.occupancy)) : std::vector<int>{};
+  std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, cell_of, groups, map.occupancy)) : std::vector<int>{};
   const double cell_area = g.resolution * g.resolution;
   dropSpecks(label, piecesOf(g, label), std::size_t(std::ceil(options.min_piece_area / cell_area)));
   const Pieces pieces = piecesOf(g, label);
