@@ -4,6 +4,8 @@
 #include "test_support.h"
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/places/localize.h>
 #include <obsgroup/places/place_map.h>
 
 #include <gtest/gtest.h>
@@ -68,6 +70,7 @@ void expectValidOutline(const Place& place, double cell_area) {
 struct Grouped {
   std::vector<Observation<pcl::PointXYZ>> observations;
   Partition partition;
+  WeightMatrix W;
   PlaceMap places;
 };
 
@@ -80,6 +83,7 @@ Grouped groupAndPlace(const sim::Building& building, std::size_t every = 1) {
   grouping.setKeepWorldPoints(true);
   for (const auto& o : out.observations) grouping.addObservation(o.cloud, o.pose);
   out.partition = grouping.compute();
+  out.W = grouping.getWeightMatrix();
   const auto overlap = grouping.getSensedSpaceOverlap();
   const ObservationRegions regions = overlap.computeRegions(out.observations, grouping.getWorldPoints());
   std::vector<Eigen::Vector3d> sensors;
@@ -169,6 +173,38 @@ TEST(Places, BadArgumentsAreRefused) {
   const PlaceMap empty = buildPlaceMap(regions, world, {}, {}, {});
   EXPECT_TRUE(empty.places.empty());
   EXPECT_FALSE(empty.locate(Eigen::Vector2d::Zero()).place);
+}
+
+}  // namespace
+}  // namespace obsgroup
+
+namespace obsgroup {
+namespace {
+
+TEST(Places, LocalizeAlignsAScanToItsPlacesLocalMap) {
+  const sim::Building office = sim::makeBuilding("office");
+  const Grouped g = groupAndPlace(office);
+  LocalMapBuilder<pcl::PointXYZ> builder;
+  builder.setVoxelLeafSize(0.05);
+  const auto maps = builder.build(g.observations, g.partition, g.W);
+  std::vector<int> ids;
+  for (const Place& p : g.places.places) ids.push_back(p.id);
+  // Scan 60 again, its pose 0.2 m and 3 degrees off.
+  const std::size_t k = 60;
+  const Eigen::Isometry3d truth = g.observations[k].pose;
+  const Eigen::Isometry3d off = Eigen::Translation3d(0.15, -0.13, 0) * truth * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ());
+  const Localization l = localize(g.places, maps, ids, *g.observations[k].cloud, off);
+  ASSERT_TRUE(l.converged);
+  ASSERT_TRUE(l.place && l.initial_place);
+  EXPECT_EQ(*l.place, ids[g.partition.group_of[k]]);
+  EXPECT_LT((l.pose.translation() - truth.translation()).norm(), 0.03);
+  EXPECT_LT(Eigen::AngleAxisd(l.pose.rotation().transpose() * truth.rotation()).angle(), 0.01);
+  EXPECT_LT(l.fitness_m2, 0.01);
+  // Off every place: nothing to align to.
+  const Localization nowhere = localize(g.places, maps, ids, *g.observations[k].cloud,
+                                        Eigen::Isometry3d(Eigen::Translation3d(1e3, 1e3, 0)));
+  EXPECT_FALSE(nowhere.place);
+  EXPECT_FALSE(nowhere.converged);
 }
 
 }  // namespace

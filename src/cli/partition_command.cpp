@@ -20,13 +20,11 @@
 #include <obsgroup/common/parallel_for.h>
 #include <obsgroup/observation_grouping.h>
 #include <obsgroup/io/pose_file.h>
+#include <obsgroup/places/localize.h>
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
-#include <pcl/common/io.h>
-#include <pcl/filters/filter.h>
 #include <pcl/io/pcd_io.h>
-#include <pcl/registration/icp.h>
 
 #include <algorithm>
 #include <charconv>
@@ -402,10 +400,6 @@ void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std
   printWritten(args);
 }
 
-/// ICP's correspondence gate for `locate --align`, metres: the pose error
-/// of a second run in a map's frame that alignment can correct.
-constexpr double kAlignMaxCorrespondence = 0.5;
-
 /// Writes `text` to `path` through a temporary file beside it, so that the
 /// file is whole or absent; an existing file is replaced only with --force.
 void writeFileAtomically(const std::string& path, const std::string& text) {
@@ -471,35 +465,6 @@ nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
   return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"qw", q.w()}, {"qx", q.x()}, {"qy", q.y()}, {"qz", q.z()}};
 }
 
-/// An observation aligned to its place's local map by PCL's ICP, from its
-/// input pose: the aligned pose in the world, whether ICP converged, and
-/// its fitness (mean squared distance of the matched points, m^2).
-template <typename PointT>
-nlohmann::json alignToPlace(const Observation<PointT>& observation, const pcl::PointCloud<PointT>& map,
-                            const Eigen::Isometry3d& map_pose, Eigen::Isometry3d& aligned) {
-  typename pcl::PointCloud<PointT>::Ptr source(new pcl::PointCloud<PointT>);
-  pcl::copyPointCloud(*observation.cloud, *source);
-  source->is_dense = false;
-  std::vector<int> kept;
-  pcl::removeNaNFromPointCloud(*source, *source, kept);
-  typename pcl::PointCloud<PointT>::Ptr target(new pcl::PointCloud<PointT>(map));
-  if (source->empty() || target->size() < 3) return {{"converged", false}, {"fitness_m2", nullptr}};
-  pcl::IterativeClosestPoint<PointT, PointT> icp;
-  icp.setInputSource(source);
-  icp.setInputTarget(target);
-  icp.setMaxCorrespondenceDistance(kAlignMaxCorrespondence);
-  icp.setMaximumIterations(50);
-  icp.setTransformationEpsilon(1e-8);
-  pcl::PointCloud<PointT> moved;
-  const Eigen::Isometry3d guess = map_pose.inverse() * observation.pose;  // the observation in the map's frame
-  icp.align(moved, guess.matrix().cast<float>());
-  if (!icp.hasConverged()) return {{"converged", false}, {"fitness_m2", nullptr}};
-  Eigen::Isometry3d found(icp.getFinalTransformation().template cast<double>());
-  found.linear() = Eigen::Quaterniond(found.rotation()).normalized().toRotationMatrix();  // ICP works in float
-  aligned = map_pose * found;
-  return {{"converged", true}, {"fitness_m2", icp.getFitnessScore(kAlignMaxCorrespondence)}};
-}
-
 /// `obsgroup locate`: each observation's place in the places of a run.
 template <typename PointT>
 int locateObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
@@ -526,17 +491,17 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
         {"place", at.place ? nlohmann::json(*at.place) : nlohmann::json()},
         {"distance_m", at.place ? nlohmann::json(at.distance_m) : nlohmann::json()}};
     if (maps && at.place) {
-      const auto [map, map_pose] = maps->of(*at.place);
-      Eigen::Isometry3d aligned = observations[i].pose;
-      nlohmann::json fit = map ? alignToPlace(observations[i], *map, map_pose, aligned)
-                               : nlohmann::json{{"converged", false}, {"fitness_m2", nullptr}};
-      if (fit.at("converged").get<bool>()) {
+      LocalizeOptions options;
+      options.tolerance = tolerance;
+      const Localization aligned = localize(
+          places, [&maps](int id) { return maps->of(id); }, *observations[i].cloud, observations[i].pose, options);
+      line["converged"] = aligned.converged;
+      line["fitness_m2"] = aligned.converged ? nlohmann::json(aligned.fitness_m2) : nlohmann::json();
+      if (aligned.converged) {
         ++converged;
-        const Location again = places.locate(aligned.translation().head<2>(), tolerance);
-        fit["aligned_pose"] = poseJson(aligned);
-        fit["aligned_place"] = again.place ? nlohmann::json(*again.place) : nlohmann::json();
+        line["aligned_pose"] = poseJson(aligned.pose);
+        line["aligned_place"] = aligned.place ? nlohmann::json(*aligned.place) : nlohmann::json();
       }
-      line.update(fit);
     }
     text += (i ? ",\n  " : "\n  ") + line.dump();
   }
