@@ -1647,3 +1647,30 @@ TEST_F(Cli, LocateAlignsAnOffsetRunToItsPlacesLocalMaps) {
   std::sort(errors.begin(), errors.end());
   EXPECT_LT(errors[errors.size() / 2], 0.1) << "median error of the aligned poses";  // 0.29 m before
 }
+
+// examples/pcl_grouping, "the few lines a PCL user needs", groups as the
+// command does with its defaults (the same GroupingParameters).
+TEST_F(Cli, ThePclExampleGivesTheCommandsGroups) {
+  const std::string pcd = kData + "/office_3d/pcd";
+  ASSERT_EQ(run("partition " + pcd + " -q --no-pictures -o " + (dir_ / "out").string()).code, 0);
+  const nlohmann::json partition = readJson(dir_ / "out" / "partition.json");
+  // The example takes the files in the order given: give them in name order, as the command reads them.
+  std::vector<std::string> sorted;
+  for (const auto& entry : fs::directory_iterator(pcd)) sorted.push_back(entry.path().string());
+  std::sort(sorted.begin(), sorted.end());
+  std::string files;
+  for (const auto& f : sorted) files += " " + f;
+  const fs::path out = dir_ / "example.txt";
+  ASSERT_EQ(std::system((std::string(PCL_GROUPING_EXE) + files + " > " + out.string()).c_str()), 0);
+  std::istringstream lines(readFile(out));
+  std::vector<std::vector<int>> groups;
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t colon = line.rfind(':');
+    ASSERT_NE(colon, std::string::npos) << line;
+    std::istringstream members(line.substr(colon + 1));
+    groups.emplace_back();
+    for (int i; members >> i;) groups.back().push_back(i);
+  }
+  EXPECT_EQ(nlohmann::json(groups), partition.at("groups"));
+  EXPECT_GT(groups.size(), 1u);
+}
