@@ -228,10 +228,14 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
   GroupingParameters params;
   params.model = c.model;
   // Each model is given only what it uses: the rest would be refused.
-  if (c.model == SensedSpaceModel::Points)
+  if (c.model == SensedSpaceModel::Points) {
     params.match_distance = c.match_distance;
-  else
+  } else if (c.model == SensedSpaceModel::FreeSpace) {
+    params.regions.cell_size = c.region.cell_size;  // the rest is the visibility model's
+    params.regions.max_range = c.region.max_range;
+  } else {
     params.regions = c.region;
+  }
   params.split = c.split;
   params.min_group_size = c.min_group_size;
   params.ncut_threshold = c.ncut_threshold;

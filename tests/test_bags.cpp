@@ -207,6 +207,9 @@ TEST_F(Ros1Bag, WithoutAMapFrameThePosesAreInOdomWithAWarning) {
   options.fixed_frame = "laser";
   EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
                                {"'laser' is the sensor's own frame", "--fixed-frame"}));
+  options.fixed_frame = "base_link";  // the robot's base, to which /tf_static fixes the laser
+  EXPECT_TRUE(throwsMentioning([&] { loadBag(path(), BagVersion::Ros1, options); },
+                               {"'base_link' moves with the sensor", "--fixed-frame"}));
   // A topic named without its leading slash is found.
   options = BagOptions{};
   options.topic = "scan";

@@ -159,8 +159,10 @@ TEST(Places, LocateReturnsTheOwnPlaceOfMostObservations) {
   // A scan standing in a doorway joins the group its overlap says, while the
   // floor under it goes to the side holding it most: 2 of the 150 land next door.
   EXPECT_GE(own, 0.95 * n) << own << " of " << n;
-  // Far from everything: no place.
+  // Far from everything: no place; a tolerance as large as one likes finds the nearest.
   EXPECT_FALSE(g.places.locate(Eigen::Vector2d(1e4, 1e4)).place);
+  EXPECT_TRUE(g.places.locate(Eigen::Vector2d(1e4, 1e4), 1e12).place);
+  EXPECT_FALSE(g.places.locate(Eigen::Vector2d(1e30, -1e30), 1.0).place);
   EXPECT_FALSE(g.places.locate(Eigen::Vector2d(NAN, 0)).place);
 }
 
@@ -173,6 +175,18 @@ TEST(Places, BadArgumentsAreRefused) {
   const PlaceMap empty = buildPlaceMap(regions, world, {}, {}, {});
   EXPECT_TRUE(empty.places.empty());
   EXPECT_FALSE(empty.locate(Eigen::Vector2d::Zero()).place);
+  // An observation with points but no region cell: no floor, no crash.
+  WorldPoints one;
+  one.appendAll({{Eigen::Vector3f(1, 2, 0), Eigen::Vector3f(-3, 0.5f, 0)}});
+  ObservationRegions no_cells;
+  no_cells.offsets = {0, 0};
+  const PlaceMap bare = buildPlaceMap(no_cells, one, {Eigen::Vector3d::Zero()}, {{0}}, {5});
+  ASSERT_EQ(bare.places.size(), 1u);
+  EXPECT_EQ(bare.places[0].area_m2, 0.0);
+  EXPECT_TRUE(bare.places[0].outline.empty());
+  PlaceOptions bad;
+  bad.min_piece_area = std::nan("");
+  EXPECT_THROW(buildPlaceMap(no_cells, one, {Eigen::Vector3d::Zero()}, {{0}}, {5}, bad), std::invalid_argument);
 }
 
 }  // namespace

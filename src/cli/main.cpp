@@ -17,6 +17,7 @@
 #include <cctype>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -330,16 +331,29 @@ std::optional<std::string> unknownOptionError(int argc, char** argv, const CLI::
     if (c->get_name() == argv[1]) command = c;
   if (!command) return std::nullopt;
   std::vector<std::string> names{"--help", "-h"};
+  std::map<std::string, int> values;  // option name -> how many values follow it
   for (const CLI::Option* option : command->get_options()) {
-    for (const std::string& l : option->get_lnames()) names.push_back("--" + l);
-    for (const std::string& n : option->get_snames()) names.push_back("-" + n);
+    std::vector<std::string> own;
+    for (const std::string& l : option->get_lnames()) own.push_back("--" + l);
+    for (const std::string& n : option->get_snames()) own.push_back("-" + n);
+    for (const std::string& name : own) {
+      names.push_back(name);
+      values[name] = std::max(0, option->get_items_expected_min());
+    }
   }
   for (int a = 2; a < argc; ++a) {
     std::string word = argv[a];
     if (word == "--") break;  // the rest are arguments
     if (word.size() < 2 || word[0] != '-' || std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.')
       continue;  // an argument, "-" (standard input) or a negative number
-    word = word.substr(0, word.find('='));
+    const std::size_t equals = word.find('=');
+    word = word.substr(0, equals);
+    if (word[1] != '-' && word.size() > 2 && values.count(word.substr(0, 2)) && values[word.substr(0, 2)] > 0)
+      continue;  // a short option with its value attached: -oOUT
+    if (const auto known = values.find(word); known != values.end()) {
+      if (equals == std::string::npos) a += known->second;  // its values, whatever they look like
+      continue;
+    }
     if (std::find(names.begin(), names.end(), word) != names.end()) continue;
     std::string nearest;
     std::size_t best = std::string::npos;

@@ -24,9 +24,12 @@
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -228,7 +231,7 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
 template <typename PointT>
 void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
                   const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps,
-                  const ObservationRegions& regions, const PlaceMap& places) {
+                  const ObservationRegions& regions, const PlaceMap* places) {
   // The points and regions as the grouping saw them, at the input poses;
   // map.png draws each observation at its refined pose.
   const WorldPoints& world = grouped.world();
@@ -241,7 +244,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   };
   render::writeMapPictures(staged, world, posesOf(observations),
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
-                           tinted ? &regions : nullptr, &places);
+                           tinted ? &regions : nullptr, places);
   render::writeWeightsPicture(staged, grouped.W, partition);
   render::writeFiedlerPicture(staged, partition);
   render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology));
@@ -294,18 +297,27 @@ ObservationRegions regionsOfRun(const PartitionArgs& args, const GroupingOutcome
 }
 
 /// places.json/.geojson, the label map and the occupancy map.
-void writePlaces(const io::OutputFolder& out, const PlaceMap& places) {
+void writePlaces(const io::OutputFolder& out, const PlaceMap& places, Warnings& warn) {
   out.writeText("places.json", io::placesJson(places));
   out.writeText("places.geojson", io::placesGeoJson(places));
-  out.write("places.png", [&places](const std::string& path) { io::writePlaceLabels(path, places); });
-  out.writeText("places.yaml", io::mapYaml(places, "places.png", "raw"));
+  int largest = -1;
+  for (const Place& place : places.places) largest = std::max(largest, place.id);
+  if (largest + 1 <= 65535) {
+    out.write("places.png", [&places](const std::string& path) { io::writePlaceLabels(path, places); });
+    out.writeText("places.yaml", io::mapYaml(places, "places.png", "raw"));
+  } else {
+    // A long stream never reuses an id: past 65534 a 16-bit label map cannot hold them.
+    warn("places.png not written: place ids reach " + std::to_string(largest) +
+         ", beyond a 16-bit label map; places.json has every place");
+  }
   out.write("occupancy.pgm", [&places](const std::string& path) { io::writeOccupancyPgm(path, places); });
   out.writeText("occupancy.yaml", io::mapYaml(places, "occupancy.pgm", "trinary"));
 }
 
 template <typename PointT>
 OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
-                         const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
+                         const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps,
+                         Warnings& warn) {
   const auto start = Clock::now();
   OutputTimes t;
   t.map_points = io::writeLocalMaps(out, maps.maps, args.method.threads);
@@ -318,13 +330,19 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   PlaceOptions place_options;
   place_options.band_low = args.method.regions.band_low;
   place_options.band_high = args.method.regions.band_high;
-  const PlaceMap places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
-                                        grouped.partition.groups, grouped.place_ids, place_options);
-  writePlaces(out, places);
+  std::optional<PlaceMap> places;
+  try {
+    places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
+                           grouped.partition.groups, grouped.place_ids, place_options);
+  } catch (const std::invalid_argument& e) {
+    // The groups and local maps stand without them.
+    warn(std::string("places not written: ") + e.what());
+  }
+  if (places) writePlaces(out, *places, warn);
   t.places_s = secondsSince(places_start);
   if (args.pictures) {
     const auto pictures_start = Clock::now();
-    drawPictures(args, out, grouped, observations, maps, regions, places);
+    drawPictures(args, out, grouped, observations, maps, regions, places ? &*places : nullptr);
     t.pictures_s = secondsSince(pictures_start);
   }
   t.outputs_s = secondsSince(start);
@@ -403,15 +421,25 @@ void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std
 /// Writes `text` to `path` through a temporary file beside it, so that the
 /// file is whole or absent; an existing file is replaced only with --force.
 void writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".obsgroup-partial";
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    if (!out.flush()) throw io::InputError(temporary + ": cannot write");
+  // A temporary of our own beside the target (never a file the user has).
+  const std::filesystem::path target(path);
+  std::string temporary = (target.parent_path() / ("." + target.filename().string() + ".obsgroup-XXXXXX")).string();
+  const int fd = mkstemp(temporary.data());
+  if (fd < 0) throw io::InputError(path + ": cannot write here");
+  const mode_t mask = umask(0);  // mkstemp makes it 0600: give it the permissions any new file gets
+  umask(mask);
+  fchmod(fd, 0666 & ~mask);
+  bool written = true;
+  for (std::size_t done = 0; done < text.size() && written;) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    written = n > 0;
+    done += written ? std::size_t(n) : 0;
   }
+  written = ::close(fd) == 0 && written;
   std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
+  if (written) std::filesystem::rename(temporary, target, ec);
+  if (!written || ec) {
     std::filesystem::remove(temporary, ec);
     throw io::InputError(path + ": cannot write");
   }
@@ -531,7 +559,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   warnAboutGrouping(observations, input, grouped, warn);
   const MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.W, warn);
   io::OutputFolder out(args.output, args.force, args.interrupt);
-  const OutputTimes written = writeResults(args, out, grouped, observations, maps);
+  const OutputTimes written = writeResults(args, out, grouped, observations, maps, warn);
   const io::RunRecord run = runRecord(args, input, grouped, maps, written, warn);
   out.writeText("partition.json", io::partitionJson(grouped.partition, run));
   out.commit();
@@ -739,8 +767,7 @@ int runPartition(const PartitionArgs& args) {
     throw io::UsageError("--realtime replays a CARMEN log or a ROS bag at its timestamps; " + args.input + " is " +
                          format + ", a format with no timestamps");
   if (args.locate) {  // fail before reading the input, not after
-    if (!std::filesystem::is_regular_file(std::filesystem::path(args.locate->places) / "places.yaml"))
-      io::readPlaceLabels(args.locate->places);  // throws the usage error that says so
+    io::readPlaceLabels(args.locate->places);  // a folder without places, or a damaged label map, before the input
     if (std::filesystem::exists(args.output) && !args.force)
       throw io::UsageError(args.output + " exists; --force replaces it");
     if (std::filesystem::is_directory(args.output)) throw io::UsageError(args.output + " is a folder, not a file");

@@ -191,6 +191,7 @@ namespace {
 struct GreyImage {
   png_uint_32 width = 0, height = 0;
   int bit_depth = 0, colour_type = 0;
+  bool interlaced = false;
 };
 
 /// Reads a PNG's header and, when it is one grey channel of 8 or 16 bits,
@@ -211,7 +212,9 @@ bool readGreyPng(std::FILE* file, GreyImage& image, png_byte* pixels, std::size_
   image.height = png_get_image_height(png, info);
   image.bit_depth = png_get_bit_depth(png, info);
   image.colour_type = png_get_color_type(png, info);
-  if (pixels && image.colour_type == PNG_COLOR_TYPE_GRAY && (image.bit_depth == 8 || image.bit_depth == 16))
+  image.interlaced = png_get_interlace_type(png, info) != PNG_INTERLACE_NONE;
+  if (pixels && !image.interlaced && image.colour_type == PNG_COLOR_TYPE_GRAY &&
+      (image.bit_depth == 8 || image.bit_depth == 16))
     for (png_uint_32 r = 0; r < image.height; ++r) png_read_row(png, pixels + std::size_t(r) * bytes_per_row, nullptr);
   png_destroy_read_struct(&png, &info, nullptr);
   return true;
@@ -264,9 +267,11 @@ PlaceMap readPlaceLabels(const std::string& folder) {
   GreyImage header;
   const bool read_header = readGreyPng(file, header, nullptr, 0);
   if (!read_header || header.colour_type != PNG_COLOR_TYPE_GRAY || (header.bit_depth != 8 && header.bit_depth != 16) ||
-      header.width == 0 || header.height == 0 || std::size_t(header.width) * header.height > (std::size_t(1) << 31)) {
+      header.interlaced || header.width == 0 || header.height == 0 ||
+      std::size_t(header.width) * header.height > std::size_t(400000000)) {
     std::fclose(file);
-    throw InputError(png_path + ": not a one-channel 8- or 16-bit PNG label map");
+    throw InputError(png_path + ": not a label map obsgroup writes (one channel, 8 or 16 bits, not interlaced, at "
+                                "most 400 million pixels)");
   }
   const std::size_t bytes_per_row = std::size_t(header.width) * (header.bit_depth == 16 ? 2 : 1);
   std::vector<png_byte> pixels(bytes_per_row * header.height);

@@ -429,7 +429,8 @@ class PoseSource {
     if (description_ == "/tf") {
       if (!tree_.connected(fixed_frame_, sensor))
         throw InputError(context + ": /tf does not connect the sensor's frame '" + sensor + "' to '" + fixed_frame_ + "'");
-      if (tree_.isAtOrBelow(fixed_frame_, sensor))
+      // The sensor's own frame, one below it, or one fixed to it by /tf_static (the robot's base).
+      if (tree_.isAtOrBelow(fixed_frame_, sensor) || tree_.staticRoot(fixed_frame_) == tree_.staticRoot(sensor))
         throw InputError(context + ": the fixed frame '" + fixed_frame_ + "' " +
                          (fixed_frame_ == sensor ? std::string("is the sensor's own frame") : "moves with the sensor ('" + sensor + "')") +
                          ": every pose would be the same; give the frame the robot moves in with --fixed-frame (the bag's "

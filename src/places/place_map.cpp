@@ -30,13 +30,28 @@ namespace {
 
 constexpr int kNone = -1;
 
-/// The grid over every region cell and every obstacle point, in the
-/// re-centred frame of the regions (`local_origin`), and the world frame.
+/// The grid over the region cells (plus a border of one cell), in the
+/// re-centred frame of the regions, and the world frame. Every position is
+/// put in a cell by one expression, from `base`, so a point on a cell edge
+/// falls in the same cell whoever asks.
 struct GridFrame {
   FloorGrid grid;
-  Eigen::Vector2d local_origin;  // re-centred coordinates of the grid's corner
-  int cellX(double x) const { return int(std::floor((x - local_origin.x()) / grid.resolution)); }
-  int cellY(double y) const { return int(std::floor((y - local_origin.y()) / grid.resolution)); }
+  Eigen::Vector2d base = Eigen::Vector2d::Zero();  // a region cell's corner, re-centred
+  Eigen::Vector2i first = Eigen::Vector2i::Zero();  // the grid's cell (0, 0), in cells from `base`
+  int cellX(double x) const { return cellFrom(x, base.x()) - first.x(); }
+  int cellY(double y) const { return cellFrom(y, base.y()) - first.y(); }
+  /// The grid index of (x, y), or nothing outside the grid.
+  std::optional<std::size_t> indexOf(double x, double y) const {
+    const int i = cellX(x), j = cellY(y);
+    if (!grid.contains(i, j)) return std::nullopt;
+    return grid.index(i, j);
+  }
+
+ private:
+  int cellFrom(double v, double b) const {
+    const double cell = std::floor((v - b) / grid.resolution);
+    return int(std::max(-1.0e9, std::min(1.0e9, cell)));  // far points stay outside, no overflow
+  }
 };
 
 bool isObstacle(const Eigen::Vector3f& p, const Eigen::Vector3d& sensor, bool planar, const PlaceOptions& options) {
@@ -45,34 +60,33 @@ bool isObstacle(const Eigen::Vector3f& p, const Eigen::Vector3d& sensor, bool pl
   return height >= options.band_low && height <= options.band_high;
 }
 
-GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
-                   const std::vector<Eigen::Vector3d>& sensors, bool planar, const PlaceOptions& options) {
+/// The grid over the regions' cells and a border of one cell: the floor
+/// lies in the regions, and an obstacle beyond them (a far return) says
+/// nothing of any place.
+GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) {
   const double cs = regions.cell_size;
   GridFrame f;
   f.grid.resolution = cs;
   if (regions.cells.empty()) return f;
   // Cell edges where the regions' are: a corner half a cell below a region cell's centre.
   const Eigen::Vector3d first = regions.cellCentre(regions.cells.front());
-  const Eigen::Vector2d base(first.x() - cs / 2, first.y() - cs / 2);
-  Eigen::AlignedBox2d cells;  // in whole cells from `base`
-  const auto extend = [&](double x, double y) {
-    cells.extend(Eigen::Vector2d(std::floor((x - base.x()) / cs), std::floor((y - base.y()) / cs)));
-  };
+  f.base = Eigen::Vector2d(first.x() - cs / 2, first.y() - cs / 2);
+  Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max());
+  Eigen::Vector2i hi = Eigen::Vector2i::Constant(std::numeric_limits<int>::min());
   for (std::uint64_t key : regions.cells) {
     const Eigen::Vector3d c = regions.cellCentre(key);
-    extend(c.x(), c.y());
+    const Eigen::Vector2i cell(f.cellX(c.x()), f.cellY(c.y()));  // `first` is still (0, 0)
+    lo = lo.cwiseMin(cell);
+    hi = hi.cwiseMax(cell);
   }
-  for (int i = 0; i < world.size(); ++i)
-    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
-      if (isObstacle(*p, sensors[i], planar, options)) extend(p->x(), p->y());
-  const Eigen::Vector2d size = cells.max() - cells.min() + Eigen::Vector2d::Ones();
+  const Eigen::Vector2d size = (hi - lo).cast<double>() + Eigen::Vector2d::Constant(3);
   if (size.x() * size.y() > 4.0e8)
     throw std::invalid_argument("buildPlaceMap: the floor grid would have more than 400 million cells of " +
                                 std::to_string(cs) + " m");
+  f.first = lo - Eigen::Vector2i::Ones();
   f.grid.width = int(size.x());
   f.grid.height = int(size.y());
-  f.local_origin = base + cs * cells.min();
-  f.grid.origin = Eigen::Vector2d(world.origin.x(), world.origin.y()) + f.local_origin;
+  f.grid.origin = Eigen::Vector2d(world.origin.x(), world.origin.y()) + f.base + cs * f.first.cast<double>();
   return f;
 }
 
@@ -82,12 +96,14 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world,
 std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensors) {
   const FloorGrid& g = f.grid;
   std::vector<char> crossed(std::size_t(g.width) * std::size_t(g.height), 0);
+  // Positions in cells of the grid, as GridFrame::cellX/cellY put them.
+  const Eigen::Vector2d corner = f.base + g.resolution * f.first.cast<double>();
   for (int i = 0; i < world.size(); ++i) {
-    const double sx = (sensors[i].x() - f.local_origin.x()) / g.resolution;
-    const double sy = (sensors[i].y() - f.local_origin.y()) / g.resolution;
+    const double sx = (sensors[i].x() - corner.x()) / g.resolution;
+    const double sy = (sensors[i].y() - corner.y()) / g.resolution;
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
-      const double ex = (double(p->x()) - f.local_origin.x()) / g.resolution;
-      const double ey = (double(p->y()) - f.local_origin.y()) / g.resolution;
+      const double ex = (double(p->x()) - corner.x()) / g.resolution;
+      const double ey = (double(p->y()) - corner.y()) / g.resolution;
       int x = int(std::floor(sx)), y = int(std::floor(sy));
       const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
       const double dx = ex - sx, dy = ey - sy;
@@ -96,7 +112,8 @@ std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, con
       const double delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
       double next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
       double next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
-      const int steps = std::abs(end_x - x) + std::abs(end_y - y);
+      // Beyond the grid a ray marks nothing: stop where it leaves for good.
+      const int steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
       for (int k = 0; k < steps; ++k) {
         if (g.contains(x, y)) crossed[g.index(x, y)] = 1;
         if (next_x < next_y) {
@@ -119,7 +136,7 @@ std::vector<std::uint32_t> gridCellsOfRegions(const ObservationRegions& regions,
   parallelFor(std::size_t(regions.size()), 0, 16, [&](std::size_t i) {
     for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
       const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
-      index[k] = std::uint32_t(f.grid.index(f.cellX(c.x()), f.cellY(c.y())));
+      index[k] = std::uint32_t(*f.indexOf(c.x(), c.y()));  // the grid holds every region cell
     }
   });
   return index;
@@ -468,10 +485,15 @@ Location PlaceMap::locate(const Eigen::Vector2d& position, double tolerance) con
     return out;
   }
   if (!(tolerance > 0)) return out;
-  const int reach = int(std::ceil(tolerance / grid.resolution)) + 1;
+  // The cells within the tolerance, clipped to the grid (in double: a huge
+  // tolerance or a far position overflows no int).
+  const double reach = std::ceil(tolerance / grid.resolution) + 1;
+  const Eigen::Vector2d at = ((position - grid.origin) / grid.resolution).array().floor();
+  const int i0 = int(std::max(0.0, at.x() - reach)), i1 = int(std::min(double(grid.width - 1), at.x() + reach));
+  const int j0 = int(std::max(0.0, at.y() - reach)), j1 = int(std::min(double(grid.height - 1), at.y() + reach));
   double best = std::numeric_limits<double>::infinity();
-  for (int j = std::max(0, c.y() - reach); j <= std::min(grid.height - 1, c.y() + reach); ++j)
-    for (int i = std::max(0, c.x() - reach); i <= std::min(grid.width - 1, c.x() + reach); ++i) {
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
       const int l = labels[grid.index(i, j)];
       if (l < 0) continue;
       const double d = (grid.cellCentre(i, j) - position).norm();
@@ -507,8 +529,13 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
     throw std::invalid_argument("buildPlaceMap: every observation must be in a group");
 
   PlaceMap map;
+  if (!(std::isfinite(options.max_door_width) && options.max_door_width >= 0) ||
+      !(std::isfinite(options.min_piece_area) && options.min_piece_area >= 0) ||
+      !(std::isfinite(options.band_low) && std::isfinite(options.band_high) && options.band_low < options.band_high))
+    throw std::invalid_argument("buildPlaceMap: the door width and piece area must be finite and >= 0, the band "
+                                "finite with low < high");
   const bool planar = isPlanarData(world, sensor_origins, regions.cell_size);
-  const GridFrame f = makeGrid(regions, world, sensor_origins, planar, options);
+  const GridFrame f = makeGrid(regions, world);
   const FloorGrid& g = f.grid;
   map.grid = g;
   const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
@@ -522,7 +549,7 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   for (int i = 0; i < n; ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
       if (isObstacle(*p, sensor_origins[i], planar, options))
-        map.occupancy[g.index(f.cellX(p->x()), f.cellY(p->y()))] = Occupancy::Occupied;
+        if (const auto k = f.indexOf(p->x(), p->y())) map.occupancy[*k] = Occupancy::Occupied;
 
   std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, cell_of, groups, map.occupancy)) : std::vector<int>{};
   const double cell_area = g.resolution * g.resolution;

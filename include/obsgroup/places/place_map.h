@@ -60,9 +60,9 @@ struct Door {
 };
 
 struct PlaceOptions {
-  /// A boundary between two places is a door when it is at most this long
-  /// and ends on both sides at something that is not floor (a wall, or space
-  /// no one sensed), metres.
+  /// Where two places touch, each cluster of their shared cell edges (edges
+  /// at most two cells apart) is a door when it spans at most this along its
+  /// main direction, metres.
   double max_door_width = 2.0;
   /// Pieces of a place smaller than this are dropped (its largest piece is
   /// always kept), square metres.
@@ -114,11 +114,13 @@ double twiceSignedArea(const std::vector<Eigen::Vector2d>& ring);
 ///   reaching through a door) and pieces below options.min_piece_area are
 ///   left to no place;
 /// - outlines follow the cell edges (4-connected pieces), doors are the
-///   short boundaries between two places that end on walls.
+///   short contacts between two places (PlaceOptions::max_door_width).
 /// `groups` are observation indices (Partition::groups), `place_ids` one id
 /// per group. `world` is the points as the grouping saw them (re-centred on
 /// world.origin, as the regions are), `sensor_origins` re-centred the same.
-/// Throws std::invalid_argument on sizes that do not match.
+/// The grid covers the regions and one cell around them; obstacles beyond
+/// (far returns) are left out. Throws std::invalid_argument on sizes that do
+/// not match, options out of range, or a grid of more than 400 million cells.
 PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& world,
                        const std::vector<Eigen::Vector3d>& sensor_origins,
                        const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
