@@ -1473,23 +1473,36 @@ TEST_F(Cli, StreamGivesTheGroupsOfPartitionAndPrintsEachChange) {
     EXPECT_EQ(p.at("statistics").at(key), batch.at("statistics").at(key)) << key;
   EXPECT_TRUE(p.at("timing_s").at("stream").is_number());
   EXPECT_NE(r.err.find("77 observations"), std::string::npos) << r.err;
-  // One line per change, named after the observation just inserted.
+  // One line per observation saying its place (a few more where a later
+  // update moved one); each observation's last line gives its place in the results.
+  std::map<int, int> final_place;
+  for (std::size_t g = 0; g < p.at("groups").size(); ++g)
+    for (int i : p.at("groups")[g]) final_place[i] = p.at("place_ids")[g];
   std::istringstream lines(r.out);
   std::string line;
-  std::set<std::string> kinds;
+  std::map<int, int> last_place;
   std::size_t count = 0;
   for (; std::getline(lines, line); ++count) {
     std::istringstream words(line);
-    std::string observation, id, group, number, kind;
-    words >> observation >> id >> group >> number >> kind;
+    std::string observation, id, place;
+    int place_id = -1;
+    words >> observation >> id >> place >> place_id;
     EXPECT_EQ(observation, "observation") << line;
-    EXPECT_EQ(id.back(), ':') << line;
-    EXPECT_EQ(group, "group") << line;
-    kinds.insert(kind);
+    ASSERT_EQ(id.back(), ':') << line;
+    EXPECT_EQ(place, "place") << line;
+    last_place[std::stoi(id)] = place_id;
   }
   EXPECT_GE(count, 77u);
-  EXPECT_EQ(r.out.rfind("observation 0: group 0 created (1 observation)\n", 0), 0u) << r.out.substr(0, 200);
-  EXPECT_TRUE(kinds.count("grown") && kinds.count("split")) << r.out;
+  EXPECT_LE(count, 2 * 77u);
+  EXPECT_EQ(last_place, final_place);
+  EXPECT_EQ(r.out.rfind("observation 0: place 0 (new place)\n", 0), 0u) << r.out.substr(0, 200);
+  EXPECT_NE(r.out.find(" split into "), std::string::npos) << r.out;
+
+  // --verbose: every change of the groups, named after the observation just inserted.
+  const Result verbose = run("stream " + input + " --verbose --no-pictures -o " + (dir_ / "verbose").string());
+  ASSERT_EQ(verbose.code, 0) << verbose.err;
+  EXPECT_EQ(verbose.out.rfind("observation 0: group 0 created (1 observation)\n", 0), 0u) << verbose.out.substr(0, 200);
+  EXPECT_NE(verbose.out.find(" grown ("), std::string::npos);
 
   // Every 10 inserts, quiet: the same groups, nothing printed.
   const Result quiet = run("stream " + input + " -q --no-pictures --update-every 10 -o " + (dir_ / "ten").string());

@@ -278,6 +278,10 @@ void addStreamOptions(CLI::App& command, obsgroup::cli::StreamOptions& stream) {
       ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Stream");
+  command.add_flag("--verbose", stream.verbose,
+                   "print every change of the groups (created, grown, split, merged, ...) instead of one line per "
+                   "observation")
+      ->group("Stream");
   command.add_flag("--realtime", stream.realtime,
                    "insert each observation at the time of its timestamp, as the robot sensed it (CARMEN logs, "
                    "ROS bags)")
@@ -431,8 +435,8 @@ int main(int argc, char** argv) {
   // stream binds the same options (only the command given parses any).
   obsgroup::cli::StreamOptions stream_options;
   CLI::App* stream = app.add_subcommand(
-      "stream", "replay the observations one at a time through the online grouping, printing each change of the "
-                "groups as it happens on stdout (-q: not); then write what partition writes");
+      "stream", "replay the observations one at a time through the online grouping, printing the place each joins "
+                "on stdout (-q: not; --verbose: every change); then write what partition writes");
   addPartitionOptions(*stream, args);
   addStreamOptions(*stream, stream_options);
   obsgroup::cli::LocateOptions locate_options;

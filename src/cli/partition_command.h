@@ -23,6 +23,9 @@ struct StreamOptions {
   /// last exact one (OnlineGrouping::setExactInterval); 1: always exact.
   int exact_every = 1;
   bool realtime = false;  ///< insert each observation at its stamp's time (logs and bags)
+  /// Print every change of the groups (created, grown, split, ...) instead of
+  /// one line per observation saying its place.
+  bool verbose = false;
 };
 
 /// What `obsgroup locate` adds: the places the observations are located in.

@@ -55,10 +55,36 @@ struct StreamTotals {
   double online_s = 0.0;  ///< inserts and updates, waits excluded
 };
 
-/// One update, its changes printed on stdout (named after the observation
-/// just inserted), unless quiet.
+/// "observation 35: place 2", and in the same line what the update did to
+/// other places: "(new place)", "(places 0 and 2 merged into 2)", "(place 3
+/// split into 3 and 14)". Ids are the online grouping's stable ids, those of
+/// partition.json's place_ids.
+inline std::string observationLine(int id, int place, const std::vector<GroupChange>& changes) {
+  const auto joined = [](const std::vector<int>& ids) {
+    std::string text;
+    for (std::size_t k = 0; k < ids.size(); ++k)
+      text += (k == 0 ? "" : k + 1 == ids.size() ? " and " : ", ") + std::to_string(ids[k]);
+    return text;
+  };
+  std::string line = "observation " + std::to_string(id) + ": place " + std::to_string(place);
+  std::vector<std::string> notes;
+  for (const GroupChange& c : changes) {
+    if (c.kind == GroupChange::Kind::Created && c.group == place) notes.push_back("new place");
+    if (c.kind == GroupChange::Kind::Merged)
+      notes.push_back("places " + joined(c.related) + " merged into " + std::to_string(c.group));
+    if (c.kind == GroupChange::Kind::Split)
+      notes.push_back("place " + std::to_string(c.group) + " split into " + joined(c.related));
+  }
+  for (std::size_t k = 0; k < notes.size(); ++k) line += (k == 0 ? " (" : "; ") + notes[k];
+  return line + (notes.empty() ? "" : ")");
+}
+
+/// One update; on stdout (unless quiet) one line per observation inserted
+/// since the last update, saying its place, or with `verbose` every change
+/// (named after the observation just inserted).
 template <typename PointT>
-void updateAndPrint(OnlineGrouping<PointT>& online, int last_id, bool last, bool quiet, StreamTotals& totals) {
+void updateAndPrint(OnlineGrouping<PointT>& online, int first_id, int last_id, bool last, bool quiet, bool verbose,
+                    StreamTotals& totals, std::vector<int>& printed_place) {
   // The last update is exact whatever --exact-every says: the outputs are the batch's.
   const GroupUpdate update = last ? online.updateExact() : online.update();
   ++totals.updates;
@@ -66,8 +92,17 @@ void updateAndPrint(OnlineGrouping<PointT>& online, int last_id, bool last, bool
   totals.split_nodes_reused += update.split_nodes_reused;
   totals.split_nodes_computed += update.split_nodes_computed;
   if (quiet) return;
-  for (const GroupChange& change : update.changes)
-    std::printf("observation %d: %s\n", last_id, describeChange(change).c_str());
+  if (verbose) {
+    for (const GroupChange& change : update.changes)
+      std::printf("observation %d: %s\n", last_id, describeChange(change).c_str());
+  } else {
+    for (int id = first_id; id <= last_id; ++id) {
+      const int place = online.getGroupOf(id);
+      std::printf("%s\n", observationLine(id, place, id == last_id ? update.changes : std::vector<GroupChange>{}).c_str());
+      printed_place.resize(std::max(printed_place.size(), std::size_t(id) + 1), -1);
+      printed_place[std::size_t(id)] = place;
+    }
+  }
   std::fflush(stdout);  // seen as it happens, on a pipe too
 }
 
@@ -80,6 +115,8 @@ StreamTotals replay(const PartitionArgs& args, OnlineGrouping<PointT>& online,
                     ReplayClock& clock) {
   StreamTotals totals;
   const std::size_t every = static_cast<std::size_t>(args.stream->update_every);
+  int first_since_update = 0;
+  std::vector<int> printed_place;  // the place each observation's line gave
   for (std::size_t k = 0; k < observations.size(); ++k) {
     clock.waitFor(k);
     const auto start = ReplayClock::Clock::now();
@@ -87,7 +124,10 @@ StreamTotals replay(const PartitionArgs& args, OnlineGrouping<PointT>& online,
     try {
       const int id = online.insert(observations[k].cloud, observations[k].pose);
       const bool last = k + 1 == observations.size();
-      if ((k + 1) % every == 0 || last) updateAndPrint(online, id, last, args.quiet, totals);
+      if ((k + 1) % every == 0 || last) {
+        updateAndPrint(online, first_since_update, id, last, args.quiet, args.stream->verbose, totals, printed_place);
+        first_since_update = id + 1;
+      }
     } catch (const InvalidObservation& e) {
       throw io::InputError(labels.at(e.index()) + ": " + e.what());  // ids are input positions: none is removed
     } catch (const std::invalid_argument& e) {
@@ -95,6 +135,12 @@ StreamTotals replay(const PartitionArgs& args, OnlineGrouping<PointT>& online,
     }
     totals.online_s += std::chrono::duration<double>(ReplayClock::Clock::now() - start).count();
   }
+  // Later updates moved some observations to other places: say where they
+  // ended, so that each observation's last line gives its place in the results.
+  for (std::size_t id = 0; id < printed_place.size(); ++id)
+    if (printed_place[id] >= 0 && online.getGroupOf(int(id)) != printed_place[id])
+      std::printf("observation %zu: place %d (moved since)\n", id, online.getGroupOf(int(id)));
+  std::fflush(stdout);
   return totals;
 }
 
