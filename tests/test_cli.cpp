@@ -1193,6 +1193,33 @@ TEST_F(Cli, ATruncatedLastLineIsAnErrorUnlessBadLinesAreSkipped) {
     previous = number;
   }
   EXPECT_EQ(m.at("stamps").size(), m.at("observations").get<std::size_t>());
+
+  // A gzip log cut short: an error, or with --skip-bad-lines every complete line read is kept.
+  writeFile(dir_ / "whole.clf", log);
+  ASSERT_EQ(std::system(("gzip -c " + (dir_ / "whole.clf").string() + " > " + (dir_ / "whole.clf.gz").string()).c_str()), 0);
+  const std::string gz = readFile(dir_ / "whole.clf.gz");
+  writeFile(dir_ / "cut.clf.gz", gz.substr(0, gz.size() * 3 / 4));
+  const Result cut_gz = run("partition " + (dir_ / "cut.clf.gz").string() + " --no-pictures -o " + (dir_ / "g").string());
+  EXPECT_EQ(cut_gz.code, 3);
+  EXPECT_NE(cut_gz.err.find("the gzip data are cut short"), std::string::npos) << cut_gz.err;
+  const Result salvaged = run("partition " + (dir_ / "cut.clf.gz").string() + " --skip-bad-lines --no-pictures -o " +
+                              (dir_ / "g").string());
+  ASSERT_EQ(salvaged.code, 0) << salvaged.err;
+  EXPECT_NE(salvaged.err.find("the gzip data are cut short: kept the "), std::string::npos) << salvaged.err;
+  const auto kept = readJson(dir_ / "g" / "partition.json").at("observations").get<int>();
+  EXPECT_GT(kept, 5);
+  EXPECT_LT(kept, 24);
+}
+
+TEST_F(Cli, AnEmptyFileIsNamedAsEmpty) {
+  writeFile(dir_ / "empty.clf", "");
+  const Result log = run("partition " + (dir_ / "empty.clf").string() + " -o " + (dir_ / "a").string());
+  EXPECT_EQ(log.code, 3);
+  EXPECT_NE(log.err.find("empty.clf: the file is empty"), std::string::npos) << log.err;
+  writeFile(dir_ / "pcd" / "000000.pcd", "");
+  const Result pcd = run("partition " + (dir_ / "pcd").string() + " -o " + (dir_ / "b").string());
+  EXPECT_EQ(pcd.code, 3);
+  EXPECT_NE(pcd.err.find("000000.pcd: the file is empty (0 bytes)"), std::string::npos) << pcd.err;
 }
 
 TEST_F(Cli, APoseFormatWithoutAPosesFileIsRefused) {

@@ -477,7 +477,15 @@ CarmenLog readCarmenLog(const std::string& path, const CarmenOptions& options) {
 }
 
 CarmenLog parseCarmenLog(std::string_view content, const std::string& path, const CarmenOptions& options) {
-  if (isGzip(content)) return parseText(gunzip(content, path), path, options);
+  if (isGzip(content)) {
+    // With --skip-bad-lines a cut gzip log keeps every complete line read
+    // (its cut last line is skipped with the other bad lines).
+    std::string cut_short;
+    CarmenLog log = parseText(gunzip(content, path, options.skip_bad_lines ? &cut_short : nullptr), path, options);
+    if (!cut_short.empty()) log.warnings.push_back(cut_short + ": kept the " + std::to_string(log.scans.size()) +
+                                                   " scans read before the cut");
+    return log;
+  }
   return parseText(content, path, options);
 }
 

@@ -81,7 +81,8 @@ std::size_t sizeHint(std::string_view bytes) {
 
 /// Inflates gzip members with zlib, streaming, appending to out[0, produced)
 /// (grown as needed); names any problem.
-void zlibInflate(std::string_view bytes, const std::string& name, std::string& out, std::size_t& produced) {
+void zlibInflate(std::string_view bytes, const std::string& name, std::string& out, std::size_t& produced,
+                 std::string* cut_short) {
   z_stream stream{};
   if (inflateInit2(&stream, 15 + 16) != Z_OK) throw InputError(name + ": cannot start inflating the gzip data");
   const auto* next = reinterpret_cast<const unsigned char*>(bytes.data());
@@ -110,8 +111,11 @@ void zlibInflate(std::string_view bytes, const std::string& name, std::string& o
     if (status == Z_DATA_ERROR || status == Z_NEED_DICT)
       throw fail(std::string("corrupt gzip data (") + (stream.msg ? stream.msg : "bad data") + ")");
     if (status == Z_MEM_ERROR) throw fail("out of memory inflating the gzip data");
-    if (status == Z_BUF_ERROR && left == 0)
-      throw fail("the gzip data are cut short (a file not completely written or copied?)");
+    if (status == Z_BUF_ERROR && left == 0) {
+      if (!cut_short) throw fail("the gzip data are cut short (a file not completely written or copied?)");
+      *cut_short = name + ": the gzip data are cut short";
+      break;  // keep what was inflated
+    }
     if (status != Z_OK && status != Z_BUF_ERROR) throw fail("cannot inflate the gzip data");
   }
   inflateEnd(&stream);
@@ -119,7 +123,7 @@ void zlibInflate(std::string_view bytes, const std::string& name, std::string& o
 
 }  // namespace
 
-std::string gunzip(std::string_view bytes, const std::string& name) {
+std::string gunzip(std::string_view bytes, const std::string& name, std::string* cut_short) {
   std::string out(sizeHint(bytes), '\0');  // one buffer, of the final size when the trailer says it
   std::size_t produced = 0;
 #ifdef OBSGROUP_HAVE_LIBDEFLATE
@@ -143,7 +147,7 @@ std::string gunzip(std::string_view bytes, const std::string& name) {
     }
   }
 #endif
-  zlibInflate(bytes, name, out, produced);
+  zlibInflate(bytes, name, out, produced, cut_short);
   out.resize(produced);
   return out;
 }

@@ -169,6 +169,7 @@ Header completeHeader(HeaderInProgress& r, const std::string& path) {
 }
 
 Header readHeader(std::ifstream& in, const std::string& path) {
+  if (in.peek() == std::char_traits<char>::eof()) throw InputError(path + ": the file is empty (0 bytes)");
   HeaderInProgress r;
   std::string line;
   for (std::size_t number = 1; std::getline(in, line); ++number) {

@@ -19,8 +19,10 @@ std::string readInputBytes(const std::string& path, const std::string& what = "f
 bool isGzip(std::string_view bytes);
 
 /// The inflated content of gzip data (one or more members). Throws
-/// InputError naming `name` when the data are corrupt or cut short.
-std::string gunzip(std::string_view bytes, const std::string& name);
+/// InputError naming `name` when the data are corrupt, or cut short unless
+/// `cut_short` is given: then what was inflated is returned and
+/// *cut_short says so.
+std::string gunzip(std::string_view bytes, const std::string& name, std::string* cut_short = nullptr);
 
 /// `content` without a leading UTF-8 byte-order mark (EF BB BF).
 std::string_view withoutByteOrderMark(std::string_view content);
