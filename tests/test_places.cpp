@@ -17,16 +17,6 @@
 namespace obsgroup {
 namespace {
 
-double signedArea(const std::vector<Eigen::Vector2d>& ring) {
-  double twice = 0;
-  for (std::size_t k = 0; k < ring.size(); ++k) {
-    const Eigen::Vector2d& a = ring[k];
-    const Eigen::Vector2d& b = ring[(k + 1) % ring.size()];
-    twice += a.x() * b.y() - b.x() * a.y();
-  }
-  return twice / 2;
-}
-
 /// Whether segments ab and cd cross at a point inside both (touching at an
 /// end point, as rings sharing a corner do, is not crossing).
 bool properlyCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
@@ -56,7 +46,7 @@ void expectValidOutline(const Place& place, double cell_area) {
     ASSERT_GE(ring.size(), 4u) << "place " << place.id;  // cell outlines have right angles only
     std::set<std::pair<double, double>> corners;
     for (const auto& p : ring) EXPECT_TRUE(corners.insert({p.x(), p.y()}).second) << "place " << place.id;
-    area += signedArea(ring);
+    area += twiceSignedArea(ring) / 2;
     for (std::size_t k = 0; k < ring.size(); ++k) edges.push_back({ring[k], ring[(k + 1) % ring.size()]});
   }
   EXPECT_NEAR(area, place.area_m2, 1e-6 * std::max(1.0, place.area_m2)) << "place " << place.id;

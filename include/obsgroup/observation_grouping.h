@@ -22,6 +22,21 @@ struct GroupingTimings {
   double partition_s = 0.0;  ///< recursive spectral bisection (sec. II)
 };
 
+/// The overlap stage with the sensed-space settings of `params` (model,
+/// regions, delta, voxel leaf, neighbour search, threads): how
+/// ObservationGrouping and OnlineGrouping filter and measure observations.
+template <typename PointT>
+SensedSpaceOverlap<PointT> sensedSpaceOverlapOf(const GroupingParameters& params) {
+  SensedSpaceOverlap<PointT> overlap;
+  overlap.setSensedSpaceModel(params.model);
+  overlap.setRegionParameters(params.regions);
+  overlap.setMatchDistance(params.match_distance);
+  overlap.setVoxelLeafSize(params.voxel_leaf);
+  overlap.setNeighbourSearch(params.neighbour_search);
+  overlap.setNumberOfThreads(params.threads);
+  return overlap;
+}
+
 /// Groups observations into consistent local maps (Blanco, Gonzalez,
 /// Fernandez-Madrigal, ICRA 2006): W_ij = Psi(n_i, n_j) (eq. 18) of the
 /// sensed-space model set (sensed_regions.h), then recursive spectral

@@ -149,9 +149,6 @@ class OnlineGrouping {
     exact_once_ = false;
   }
   int firstPresent() const;
-  /// The batch's overlap stage with these settings: it filters and moves
-  /// each observation exactly as ObservationGrouping does.
-  SensedSpaceOverlap<PointT> overlapStage() const;
   std::vector<Eigen::Vector3f> worldPointsOf(int id, const Observation<PointT>& observation,
                                              const Eigen::Vector3d& origin) const;
   void recentreAll();

@@ -31,14 +31,8 @@ void ObservationGrouping<PointT>::clear() {
 
 template <typename PointT>
 SensedSpaceOverlap<PointT> ObservationGrouping<PointT>::getSensedSpaceOverlap() const {
-  SensedSpaceOverlap<PointT> overlap;
-  overlap.setSensedSpaceModel(params_.model);
-  overlap.setRegionParameters(params_.regions);
-  overlap.setMatchDistance(params_.match_distance);
-  overlap.setVoxelLeafSize(params_.voxel_leaf);
-  overlap.setNeighbourSearch(params_.neighbour_search);
+  SensedSpaceOverlap<PointT> overlap = sensedSpaceOverlapOf<PointT>(params_);
   if (search_ && params_.neighbour_search == NeighbourSearch::PclSearch) overlap.setSearchMethod(search_);
-  overlap.setNumberOfThreads(params_.threads);
   overlap.setProgressCallback(progress_);
   overlap.setInterruptFlag(interrupt_);
   return overlap;

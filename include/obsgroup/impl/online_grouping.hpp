@@ -29,16 +29,6 @@ PartitionOptions OnlineGrouping<PointT>::getPartitionOptions() const {
 }
 
 template <typename PointT>
-SensedSpaceOverlap<PointT> OnlineGrouping<PointT>::overlapStage() const {
-  SensedSpaceOverlap<PointT> overlap;
-  overlap.setSensedSpaceModel(params_.model);
-  overlap.setRegionParameters(params_.regions);
-  overlap.setMatchDistance(params_.match_distance);
-  overlap.setVoxelLeafSize(params_.voxel_leaf);
-  return overlap;
-}
-
-template <typename PointT>
 int OnlineGrouping<PointT>::firstPresent() const {
   for (int i = 0; i < int(slots_.size()); ++i)
     if (slots_[i].present) return i;
@@ -51,7 +41,7 @@ std::vector<Eigen::Vector3f> OnlineGrouping<PointT>::worldPointsOf(int id, const
   if (!observation.cloud) throw InvalidObservation(id, "null cloud");
   if (!observation.pose.matrix().allFinite()) throw InvalidObservation(id, "pose is not finite");
   try {
-    return overlapStage().observationToWorld(observation, origin);
+    return sensedSpaceOverlapOf<PointT>(params_).observationToWorld(observation, origin);
   } catch (const InvalidObservation&) {
     throw;
   } catch (const std::exception& e) {
