@@ -44,7 +44,7 @@ endmacro()
 # obsgroup::io (the readers): PCL's io, zlib (gzip input), libpng (depth
 # images) and, when installed, libdeflate (a faster inflate).
 macro(obsgroup_find_io_dependencies)
-  obsgroup_find_pcl(${OBSGROUP_PCL_MINIMUM_VERSION} REQUIRED COMPONENTS common io)
+  obsgroup_find_pcl(${OBSGROUP_PCL_MINIMUM_VERSION} REQUIRED COMPONENTS common io filters)
   find_package(ZLIB REQUIRED)
   find_package(PNG REQUIRED)
   find_package(PkgConfig REQUIRED)

@@ -1314,6 +1314,9 @@ TEST_F(Cli, SimulatedDepthImagesGroupAsTheSamePcdSequence) {
   EXPECT_EQ(p.at("parameters").at("format"), "tum-rgbd");
   EXPECT_EQ(p.at("parameters").at("depth_scale"), 5000.0);
   EXPECT_EQ(p.at("parameters").at("skipped_frames"), 0);
+  // 80 x 60 pixels is not a dense frame: kept whole unless a --voxel is given.
+  EXPECT_EQ(p.at("parameters").at("frame_voxel"), 0.05);
+  EXPECT_EQ(p.at("parameters").at("frames_reduced"), 0);
   ASSERT_EQ(run("partition " + kData + "/office_3d/pcd -q --no-pictures -o " + (dir_ / "b").string()).code, 0);
   const nlohmann::json q = readJson(dir_ / "b" / "partition.json");
   EXPECT_EQ(p.at("groups"), q.at("groups"));
@@ -1324,6 +1327,15 @@ TEST_F(Cli, SimulatedDepthImagesGroupAsTheSamePcdSequence) {
   ASSERT_EQ(strided.code, 0) << strided.err;
   EXPECT_LT(readJson(dir_ / "c" / "partition.json").at("statistics").at("points").get<double>(),
             0.3 * q.at("statistics").at("points").get<double>());
+  // --voxel: every frame filtered as it is read, and said so.
+  const Result voxel = run("partition " + tum.string() + " -q --no-pictures --voxel 0.1 --intrinsics " + intrinsics +
+                           " -o " + (dir_ / "d").string());
+  ASSERT_EQ(voxel.code, 0) << voxel.err;
+  const nlohmann::json d = readJson(dir_ / "d" / "partition.json");
+  EXPECT_EQ(d.at("parameters").at("frame_voxel"), 0.1);
+  EXPECT_EQ(d.at("parameters").at("frames_reduced"), 40);
+  EXPECT_EQ(d.at("parameters").at("voxel"), 0.1);
+  EXPECT_LT(d.at("statistics").at("points").get<double>(), 0.8 * q.at("statistics").at("points").get<double>());
 }
 
 namespace {

@@ -3,6 +3,7 @@
 #include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/io/depth_sequence.h>
 #include <obsgroup/io/errors.h>
+#include <obsgroup/io/frame_reduction.h>
 #include <obsgroup/io/kitti_sequence.h>
 #include <obsgroup/io/pcd_sequence.h>
 #include <obsgroup/io/pose_file.h>
@@ -12,6 +13,7 @@
 #include <pcl/point_types.h>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 #include <zlib.h>
 
 #include <unistd.h>
@@ -24,6 +26,8 @@
 #include <functional>
 #include <iterator>
 #include <map>
+#include <set>
+#include <tuple>
 
 using namespace obsgroup::io;
 namespace fs = std::filesystem;
@@ -815,4 +819,132 @@ TEST_F(DatasetFolder, APngHeaderLargerThanItsDataIsRefusedBeforeAllocating) {
                          "file can hold"),
             std::string::npos)
       << message;
+}
+
+// ---------------------------------------------------------------------------
+// Dense frames reduced as they are read.
+
+namespace {
+
+/// The voxel keys of a cloud at `leaf`, as pcl::VoxelGrid numbers them.
+std::set<std::tuple<long, long, long>> voxelKeys(const pcl::PointCloud<pcl::PointXYZ>& cloud, double leaf) {
+  std::set<std::tuple<long, long, long>> keys;
+  for (const auto& p : cloud)
+    keys.emplace(long(std::floor(p.x / leaf)), long(std::floor(p.y / leaf)), long(std::floor(p.z / leaf)));
+  return keys;
+}
+
+pcl::PointCloud<pcl::PointXYZ> scattered(std::size_t count, float spread, unsigned seed) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::srand(seed);
+  for (std::size_t k = 0; k < count; ++k)
+    cloud.push_back({spread * float(std::rand()) / float(RAND_MAX), spread * float(std::rand()) / float(RAND_MAX),
+                     0.5f * spread * float(std::rand()) / float(RAND_MAX)});
+  return cloud;
+}
+
+}  // namespace
+
+TEST(FrameReduction, EachOccupiedVoxelBecomesOnePointAndAgainChangesNothing) {
+  pcl::PointCloud<pcl::PointXYZ> cloud = scattered(20000, 2.0f, 1);
+  cloud.push_back({std::nanf(""), 0.0f, 0.0f});
+  const auto keys = voxelKeys(scattered(20000, 2.0f, 1), 0.1);
+  const FrameReduction reduction{0.1, 0, {}};
+  ASSERT_TRUE(reduceFrame(cloud, cloud.size(), reduction));
+  EXPECT_EQ(cloud.size(), keys.size());           // one point per occupied voxel, the NaN gone
+  EXPECT_EQ(voxelKeys(cloud, 0.1), keys);          // each inside its own voxel
+  EXPECT_EQ(cloud.height, 1u);
+  const pcl::PointCloud<pcl::PointXYZ> once = cloud;
+  ASSERT_TRUE(reduceFrame(cloud, cloud.size(), reduction));
+  ASSERT_EQ(cloud.size(), once.size());  // so the grouping's own filter at the same leaf is a no-op
+}
+
+TEST(FrameReduction, OnlyDenseFramesAreReducedByDefault) {
+  const FrameReduction reduction = FrameReduction::denseDefault();
+  pcl::PointCloud<pcl::PointXYZ> cloud = scattered(5000, 2.0f, 2);
+  EXPECT_FALSE(reduceFrame(cloud, kDenseFramePoints - 1, reduction));  // a light sensor: every point kept
+  EXPECT_EQ(cloud.size(), 5000u);
+  EXPECT_TRUE(reduceFrame(cloud, kDenseFramePoints, reduction));  // a dense one, whatever is left of it
+  EXPECT_LT(cloud.size(), 5000u);
+  EXPECT_FALSE(reduceFrame(cloud, 1000000, FrameReduction{0.0, 0, {}}));  // --voxel 0 keeps everything
+}
+
+TEST(FrameReduction, ACloudTooWideForVoxelGridIsFilteredInPartsWithTheSameVoxels) {
+  // 4 km by 4 km by 400 m at 1 cm: far beyond VoxelGrid's 2^31 voxels, which
+  // would hand the cloud back unfiltered.
+  pcl::PointCloud<pcl::PointXYZ> cloud = scattered(3000, 0.05f, 3);
+  for (const auto& p : scattered(3000, 0.05f, 4)) cloud.push_back({p.x + 4000.0f, p.y - 4000.0f, p.z + 400.0f});
+  const auto keys = voxelKeys(cloud, 0.01);
+  ASSERT_TRUE(reduceFrame(cloud, cloud.size(), FrameReduction{0.01, 0, {}}));
+  EXPECT_EQ(cloud.size(), keys.size());
+  EXPECT_EQ(voxelKeys(cloud, 0.01), keys);
+}
+
+TEST(FrameReduction, TheFirstFailingFrameIsReportedOnAnyNumberOfThreads) {
+  for (int threads : {1, 2, 4}) {
+    omp_set_num_threads(threads);
+    std::vector<std::size_t> progress;
+    std::string message;
+    try {
+      readFramesInParallel(
+          50,
+          [](std::size_t k) {
+            if (k == 7 || k == 30) throw InputError("frame " + std::to_string(k));
+          },
+          [&](std::size_t done, std::size_t total) {
+            EXPECT_EQ(total, 50u);
+            progress.push_back(done);
+          });
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    EXPECT_EQ(message, "frame 7") << threads << " threads";
+    EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  std::vector<std::size_t> read(100, 0);
+  readFramesInParallel(100, [&](std::size_t k) { read[k] = k + 1; }, {});
+  for (std::size_t k = 0; k < read.size(); ++k) EXPECT_EQ(read[k], k + 1);
+}
+
+TEST_F(DatasetFolder, DepthFramesAreReducedAsTheyAreReadTheSameOnAnyNumberOfThreads) {
+  // A 200 x 120 image (24,000 pixels: dense) of a wall 2 m away, three frames.
+  const std::vector<std::uint16_t> wall(200 * 120, 2000);
+  Eigen::Matrix4d a = Eigen::Matrix4d::Identity();
+  std::string log;
+  for (int k = 0; k < 3; ++k) {
+    png("depth/" + std::to_string(k) + ".png", 200, 120, wall);
+    a(0, 3) = 0.1 * k;
+    log += redwoodBlock(k, a);
+  }
+  text("trajectory.log", log);
+  DepthOptions options;
+  options.up = UpAxis::PlusZ;
+  options.intrinsics = {100.0, 100.0, 99.5, 59.5};
+  const DepthSequence whole = loadDepthSequence(dir_.string(), DepthLayout::Redwood, options);
+  EXPECT_EQ(whole.reduced, 0u);
+  EXPECT_EQ(whole.observations[0].cloud->size(), 24000u);
+  options.reduction = FrameReduction::denseDefault();
+  std::size_t calls = 0;
+  options.reduction.progress = [&](std::size_t done, std::size_t total) {
+    ++calls;
+    EXPECT_LE(done, total);
+  };
+  std::vector<std::vector<float>> coordinates;
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    const DepthSequence reduced = loadDepthSequence(dir_.string(), DepthLayout::Redwood, options);
+    EXPECT_EQ(reduced.reduced, 3u);
+    ASSERT_EQ(reduced.observations.size(), 3u);
+    // A 4 x 2.4 m patch of wall at 5 cm: about 80 x 48 voxels, not 24,000 points.
+    EXPECT_LT(reduced.observations[0].cloud->size(), 5000u);
+    EXPECT_GT(reduced.observations[0].cloud->size(), 3000u);
+    std::vector<float> all;
+    for (const auto& o : reduced.observations)
+      for (const auto& p : *o.cloud) all.insert(all.end(), {p.x, p.y, p.z});
+    coordinates.push_back(all);
+  }
+  omp_set_num_threads(omp_get_num_procs());
+  EXPECT_EQ(coordinates[0], coordinates[1]);
+  EXPECT_EQ(calls, 6u);
 }

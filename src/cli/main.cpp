@@ -5,6 +5,7 @@
 // or SIGTERM: the output folder is left as it was), 1 anything else.
 
 #include <obsgroup/io/errors.h>
+#include <obsgroup/io/frame_reduction.h>
 #include "option_checks.h"
 #include "partition_command.h"
 
@@ -182,9 +183,11 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
       ->group("Method");
-  command.add_option("--voxel", args.method.voxel_leaf, "voxel downsampling leaf before matching, metres (0 = off)")
+  command.add_option("--voxel", args.voxel,
+                     "voxel leaf of every observation, metres, applied as each frame is read (0 = keep every point; "
+                     "default: dense frames of " + std::to_string(obsgroup::io::kDenseFramePoints) + "+ points at " +
+                         number(obsgroup::io::kDefaultFrameVoxel) + ", others whole)")
       ->check(finiteNumber(0.0))
-      ->capture_default_str()
       ->group("Method");
   command.add_option("--ncut-threshold", args.method.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
       ->check(finiteNumber(0.0, false, 2.0))
@@ -403,6 +406,7 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
   if (args.method.model == SensedSpaceModel::FreeSpace)
     for (const char* option : {"--clearance", "--min-observations", "--band"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
+  if (args.voxel) args.method.voxel_leaf = *args.voxel;
   if (!args.band.empty()) {
     if (!(args.band[0] < args.band[1]))
       return "--band: LOW must be below HIGH (got " + std::to_string(args.band[0]) + " " +

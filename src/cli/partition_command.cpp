@@ -126,6 +126,21 @@ class Warnings {
   std::vector<std::string> all_;
 };
 
+/// How the readers of dense inputs reduce each frame: at --voxel when given,
+/// else dense frames at the default leaf; the bar counts the frames read.
+io::FrameReduction frameReduction(const PartitionArgs& args, ProgressBar& bar) {
+  io::FrameReduction reduction = args.voxel ? io::FrameReduction{*args.voxel, 0, {}} : io::FrameReduction::denseDefault();
+  reduction.progress = [&bar](std::size_t done, std::size_t total) { bar(done, total); };
+  return reduction;
+}
+
+/// What partition.json records of the reduction: the leaf and how many frames it filtered.
+void recordReduction(const io::FrameReduction& reduction, std::size_t reduced, nlohmann::json& parameters) {
+  parameters["frame_voxel"] = reduction.voxel_leaf;
+  parameters["frame_voxel_min_points"] = reduction.min_points;
+  parameters["frames_reduced"] = reduced;
+}
+
 template <typename PointT>
 std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<PointT>>& observations) {
   std::vector<Eigen::Isometry3d> poses;
@@ -242,12 +257,16 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
                                               const std::function<void(const std::string&)>& write) {
     out.write(name, write);
   };
+  // 3D input is drawn as a horizontal slice: the visibility model's band, without floor and ceiling.
+  const bool planar = isPlanarData(world, sensorOrigins(observations, world), args.method.regions.cell_size);
+  const render::HeightBand band{args.method.regions.band_low, args.method.regions.band_high};
+  const render::HeightBand* slice = planar ? nullptr : &band;
   render::writeMapPictures(staged, world, posesOf(observations),
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
-                           tinted ? &regions : nullptr, places);
+                           tinted ? &regions : nullptr, places, slice);
   render::writeWeightsPicture(staged, grouped.W, partition);
   render::writeFiedlerPicture(staged, partition);
-  render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology));
+  render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology), slice);
 }
 
 /// The settings the grouping ran with, as partition.json records them: only
@@ -653,7 +672,10 @@ int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointK
       poses = io::parsePoses(bytes, name, *pose_format);
     }
   }
-  io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""));
+  ProgressBar bar("read", !args.quiet);
+  const io::FrameReduction reduction = frameReduction(args, bar);
+  io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""), reduction);
+  bar.finish();
   InputRecord input;
   input.format = "pcd";
   input.labels = files;
@@ -661,6 +683,7 @@ int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointK
                       {"pose_format", pose_format ? nlohmann::json(io::toString(*pose_format)) : nlohmann::json()},
                       {"point_type", io::toString(kind)}};
   if (args.poses) input.parameters["poses_matched_by"] = matched;
+  recordReduction(reduction, sequence.reduced, input.parameters);
   input.warnings = std::move(warnings);
   for (auto& w : sequence.warnings) input.warnings.push_back(std::move(w));
   input.load_s = secondsSince(start);
@@ -677,7 +700,10 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
   options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
   options.poses = args.poses;
   options.up = args.up;
+  ProgressBar bar("read", !args.quiet);
+  options.reduction = frameReduction(args, bar);
   io::DepthSequence sequence = io::loadDepthSequence(args.input, layout, options);
+  bar.finish();
   InputRecord input;
   input.format = io::toString(layout);
   input.labels = std::move(sequence.labels);
@@ -693,6 +719,7 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
     input.parameters["skipped_frames"] = sequence.skipped;
   }
   if (args.poses) input.parameters["poses"] = *args.poses;
+  recordReduction(options.reduction, sequence.reduced, input.parameters);
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
   return runPipeline(args, std::move(sequence.observations), std::move(input));
@@ -700,21 +727,27 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
 
 int runKitti(const PartitionArgs& args) {
   const auto start = Clock::now();
-  io::KittiSequence sequence = io::loadKittiSequence(args.input, args.poses);
+  ProgressBar bar("read", !args.quiet);
+  const io::FrameReduction reduction = frameReduction(args, bar);
+  io::KittiSequence sequence = io::loadKittiSequence(args.input, args.poses, reduction);
+  bar.finish();
   InputRecord input;
   input.format = "kitti";
   input.labels = std::move(sequence.labels);
   input.parameters = {{"poses", sequence.poses_file},
                       {"calibration", sequence.calib_file},
                       {"point_type", io::toString(io::PointKind::XYZI)}};
+  recordReduction(reduction, sequence.reduced, input.parameters);
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
   return runPipeline(args, std::move(sequence.observations), std::move(input));
 }
 
 template <typename PointT>
-int runBagAs(const PartitionArgs& args, const io::BagReader& reader, io::PointKind kind, Clock::time_point start) {
+int runBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::FrameReduction& reduction,
+             ProgressBar& bar, io::PointKind kind, Clock::time_point start) {
   io::BagSequenceOf<PointT> sequence = reader.observations<PointT>();
+  bar.finish();
   InputRecord input;
   input.format = io::toString(sequence.version);
   input.labels = std::move(sequence.labels);
@@ -725,6 +758,7 @@ int runBagAs(const PartitionArgs& args, const io::BagReader& reader, io::PointKi
                       {"fixed_frame", sequence.fixed_frame.empty() ? nlohmann::json() : nlohmann::json(sequence.fixed_frame)},
                       {"skipped_messages", sequence.skipped},
                       {"point_type", io::toString(kind)}};
+  recordReduction(reduction, sequence.reduced, input.parameters);
   if (args.poses) {
     input.parameters["poses"] = *args.poses;
     input.parameters["max_time_difference"] = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
@@ -747,13 +781,15 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   options.fixed_frame = args.fixed_frame;
   options.poses_file = args.poses;
   options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
+  ProgressBar bar("convert", !args.quiet);
+  options.reduction = frameReduction(args, bar);
   const io::BagReader reader(args.input, version, options);
   switch (const io::PointKind kind = reader.pointKind()) {
-    case io::PointKind::XYZI: return runBagAs<pcl::PointXYZI>(args, reader, kind, start);
-    case io::PointKind::XYZRGB: return runBagAs<pcl::PointXYZRGB>(args, reader, kind, start);
+    case io::PointKind::XYZI: return runBagAs<pcl::PointXYZI>(args, reader, options.reduction, bar, kind, start);
+    case io::PointKind::XYZRGB: return runBagAs<pcl::PointXYZRGB>(args, reader, options.reduction, bar, kind, start);
     case io::PointKind::XYZ: break;
   }
-  return runBagAs<pcl::PointXYZ>(args, reader, io::PointKind::XYZ, start);
+  return runBagAs<pcl::PointXYZ>(args, reader, options.reduction, bar, io::PointKind::XYZ, start);
 }
 
 }  // namespace

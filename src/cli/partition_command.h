@@ -65,6 +65,9 @@ struct PartitionArgs {
   /// across lasers and depth cameras with drifted poses, docs/grouping.md);
   /// `--paper` gives the paper's.
   GroupingParameters method;
+  /// --voxel as given: every frame's leaf (in the readers and the grouping);
+  /// none: dense frames at io::kDefaultFrameVoxel as they are read.
+  std::optional<double> voxel;
   std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
   Refinement refine = Refinement::None;
   bool paper = false;         ///< --paper: the preset, applied by the command line

@@ -475,8 +475,10 @@ class PoseSource {
 
 template <typename PointT, typename Message>
 void addObservations(const std::vector<Numbered<Message>>& messages, const std::string& topic, PoseSource& poses,
-                     const std::string& bag_name, BagSequenceOf<PointT>& sequence) {
+                     const std::string& bag_name, const FrameReduction& reduction, BagSequenceOf<PointT>& sequence) {
+  std::size_t done = 0;
   for (const auto& [number, message] : messages) {
+    if (reduction.progress) reduction.progress(++done, messages.size());
     const std::string label = bag_name + ": message " + std::to_string(number) + " on " + topic;
     if (message.header.frame_id.empty()) throw InputError(label + ": field header.frame_id: empty");
     const auto pose = poses.at(message.header.frame_id, message.header.stamp, label);
@@ -488,6 +490,7 @@ void addObservations(const std::vector<Numbered<Message>>& messages, const std::
       sequence.observations.push_back({scanPoints<PointT>(message), *pose});
     } else {
       auto cloud = cloudPoints<PointT>(message, label);
+      sequence.reduced += reduceFrame(*cloud, std::size_t(message.cloud.width) * message.cloud.height, reduction);
       Eigen::Isometry3d body_pose = *pose;
       if (isOpticalFrame(message.header.frame_id)) {  // as depth images: into the body frame, z up
         const Eigen::Matrix3f to_body = kOpticalInBody.cast<float>();
@@ -582,8 +585,8 @@ BagSequenceOf<PointT> BagReader::observations() const {
   PoseSource poses(c.messages, c.options, c.path, c.topics, sequence.warnings);
   sequence.pose_source = poses.description();
   sequence.fixed_frame = poses.fixedFrame();
-  addObservations(c.messages.scans, c.data.name, poses, c.path, sequence);
-  addObservations(c.messages.clouds, c.data.name, poses, c.path, sequence);
+  addObservations(c.messages.scans, c.data.name, poses, c.path, c.options.reduction, sequence);
+  addObservations(c.messages.clouds, c.data.name, poses, c.path, c.options.reduction, sequence);
   const std::size_t total = c.messages.scans.size() + c.messages.clouds.size();
   if (sequence.observations.empty())
     throw InputError(c.path + ": none of the " + std::to_string(total) + " messages on " + c.data.name +

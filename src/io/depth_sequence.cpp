@@ -274,21 +274,52 @@ void putUpOnZ(std::vector<Eigen::Isometry3d>& optical_poses, UpAxis up, bool cho
                          "): turned to put it on z, as obsgroup's height band and pictures from above assume");
 }
 
-void addFrame(DepthSequence& out, const std::string& file, const Eigen::Isometry3d& optical_pose,
-              const DepthOptions& options) {
-  const DepthImage image = readDepthPng(file);
-  auto cloud = backProject(image, options.intrinsics, out.depth_scale, options.max_depth, options.stride);
-  if (cloud->empty()) out.warnings.push_back(file + ": the depth image has no valid pixel; kept as an observation (a group of its own)");
+/// One frame in the camera's body frame, reduced as `options` say; `warning`
+/// says when it has no point.
+Observation<pcl::PointXYZ> readFrame(const std::string& file, const Eigen::Isometry3d& optical_pose,
+                                     const DepthOptions& options, double depth_scale, bool& reduced,
+                                     std::string& warning) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  std::size_t pixels = 0;
+  {
+    const DepthImage image = readDepthPng(file);  // freed before the next frame is read
+    const std::size_t stride = std::size_t(std::max(1, options.stride));
+    pixels = ((std::size_t(image.width) + stride - 1) / stride) * ((std::size_t(image.height) + stride - 1) / stride);
+    cloud = backProject(image, options.intrinsics, depth_scale, options.max_depth, options.stride);
+  }
+  if (cloud->empty()) warning = file + ": the depth image has no valid pixel; kept as an observation (a group of its own)";
   // Into the camera's body frame, where the local maps are drawn from above
   // and the pose arrows point where the camera looks; the world points stay.
   const Eigen::Matrix3f to_body = kOpticalInBody.cast<float>();
   for (auto& p : cloud->points) p.getVector3fMap() = to_body * p.getVector3fMap();
+  reduced = reduceFrame(*cloud, pixels, options.reduction);
   Eigen::Isometry3d pose = optical_pose;
   pose.linear() = optical_pose.linear() * kOpticalInBody.transpose();
   cloud->sensor_origin_ << pose.translation().cast<float>(), 0.0f;
   cloud->sensor_orientation_ = Eigen::Quaternionf(pose.linear().cast<float>());
-  out.observations.push_back({cloud, pose});
-  out.labels.push_back(file);
+  return {cloud, pose};
+}
+
+/// Every frame, in parallel; the first error (in frame order) is thrown.
+void readFrames(const std::vector<std::string>& files, const std::vector<Eigen::Isometry3d>& optical_poses,
+                const DepthOptions& options, DepthSequence& out) {
+  std::vector<Observation<pcl::PointXYZ>> observations(files.size());
+  std::vector<std::string> warnings(files.size());
+  std::vector<char> reduced(files.size(), 0);
+  readFramesInParallel(
+      files.size(),
+      [&](std::size_t k) {
+        bool frame_reduced = false;
+        observations[k] = readFrame(files[k], optical_poses[k], options, out.depth_scale, frame_reduced, warnings[k]);
+        reduced[k] = frame_reduced;
+      },
+      options.reduction.progress);
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    out.observations.push_back(std::move(observations[k]));
+    out.labels.push_back(files[k]);
+    if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));
+    out.reduced += reduced[k];
+  }
 }
 
 }  // namespace
@@ -315,7 +346,7 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
     }
     const UpAxis up = options.up.value_or(UpAxis::PlusZ);
     putUpOnZ(matched, up == UpAxis::Auto ? camerasUpAxis(matched) : up, options.up.has_value(), truth, out);
-    for (std::size_t k = 0; k < files.size(); ++k) addFrame(out, files[k], matched[k], options);
+    readFrames(files, matched, options, out);
     if (out.observations.empty())
       throw InputError(truth + ": no pose within " + std::to_string(options.max_time_difference) +
                        " s of any of the " + std::to_string(frames.size()) +
@@ -339,7 +370,7 @@ DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, c
   poses.resize(std::min(poses.size(), files.size()));
   const UpAxis up = options.up.value_or(UpAxis::Auto);
   putUpOnZ(poses, up == UpAxis::Auto ? camerasUpAxis(poses) : up, options.up.has_value(), log, out);
-  for (std::size_t k = 0; k < files.size(); ++k) addFrame(out, files[k], poses[k], options);
+  readFrames(files, poses, options, out);
   return out;
 }
 

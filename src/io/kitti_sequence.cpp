@@ -65,7 +65,8 @@ Eigen::Isometry3d parseKittiCalibration(std::string_view content, const std::str
   throw InputError(path + ": no 'Tr:' line (the velodyne-to-camera calibration)");
 }
 
-KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses_path) {
+KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses_path,
+                                const FrameReduction& reduction) {
   const fs::path dir(folder);
   KittiSequence out;
   std::error_code ec;
@@ -84,10 +85,14 @@ KittiSequence loadKittiSequence(const std::string& folder, const std::optional<s
     throw InputError(out.calib_file + ": no such file (KITTI poses are the camera's: the Tr velodyne-to-camera "
                      "line of calib.txt makes them the lidar's)");
   const Eigen::Isometry3d tr = parseKittiCalibration(readInputBytes(out.calib_file, "calibration"), out.calib_file);
-  for (std::size_t k = 0; k < scans.size(); ++k) {
+  out.observations.resize(scans.size());
+  std::vector<std::string> warnings(scans.size());
+  std::vector<char> reduced(scans.size(), 0);
+  const auto read = [&](std::size_t k) {
     const std::string& file = scans[k];
     auto cloud = decodeKittiScan(readInputBytes(file, "velodyne scan"), file);
-    if (cloud->empty()) out.warnings.push_back(file + ": the scan has no point; kept as an observation (a group of its own)");
+    if (cloud->empty()) warnings[k] = file + ": the scan has no point; kept as an observation (a group of its own)";
+    reduced[k] = reduceFrame(*cloud, cloud->size(), reduction);
     // KITTI's world is camera 0 at the start: y down, z ahead. Expressed in
     // the first velodyne frame instead (Tr^-1 P Tr, as lidar odometry
     // evaluates KITTI), z is up, which the height band of the sensed regions,
@@ -95,8 +100,13 @@ KittiSequence loadKittiSequence(const std::string& folder, const std::optional<s
     const Eigen::Isometry3d pose = tr.inverse() * camera[k] * tr;
     cloud->sensor_origin_ << pose.translation().cast<float>(), 0.0f;
     cloud->sensor_orientation_ = Eigen::Quaternionf(pose.linear().cast<float>());
-    out.observations.push_back({cloud, pose});
-    out.labels.push_back(file);
+    out.observations[k] = {cloud, pose};
+  };
+  readFramesInParallel(scans.size(), read, reduction.progress);
+  out.labels = scans;
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));
+    out.reduced += reduced[k];
   }
   return out;
 }

@@ -154,35 +154,49 @@ PointKind pointKindOfFields(const std::vector<pcl::PCLPointField>& fields) {
 template <typename PointT>
 PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
                                     const std::optional<std::vector<Eigen::Isometry3d>>& poses,
-                                    const std::string& poses_file) {
+                                    const std::string& poses_file, const FrameReduction& reduction) {
   if (poses && poses->size() != files.size())
     throw InputError(poses_file + ": " + std::to_string(poses->size()) + " poses for " +
                      std::to_string(files.size()) + " PCD files (one pose per file, in name order)");
   PcdSequence<PointT> out;
-  pcl::PCDReader reader;
-  std::size_t identity_viewpoints = 0;
-  for (std::size_t k = 0; k < files.size(); ++k) {
+  out.observations.resize(files.size());
+  std::vector<std::string> warnings(files.size());
+  std::vector<char> reduced(files.size(), 0), identity(files.size(), 0);
+  const auto read = [&](std::size_t k) {
+    pcl::PCDReader reader;
     typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
     checkPcdFile(files[k]);
-    pcl::PCLPointCloud2 blob;
-    int version = 0;
-    pclCall(files[k], [&] { return reader.read(files[k], blob, cloud->sensor_origin_, cloud->sensor_orientation_, version); },
-            "cannot parse this PCD file (malformed header or truncated data)");
-    checkCoordinateFields(blob, files[k]);  // every file, not only the first
-    checkBlobSize(blob, files[k]);
-    // pcl::fromPCLPointCloud2 indexes point 0 of an empty cloud (PCL 1.13):
-    // what pcl::PCDReader::read<PointT> does, minus that.
-    if (blob.width * blob.height > 0) {
-      const Eigen::Vector4f origin = cloud->sensor_origin_;
-      const Eigen::Quaternionf orientation = cloud->sensor_orientation_;
-      pcl::fromPCLPointCloud2(blob, *cloud);
-      cloud->sensor_origin_ = origin;
-      cloud->sensor_orientation_ = orientation;
+    std::size_t sensor_points = 0;
+    {
+      pcl::PCLPointCloud2 blob;  // the file's bytes, freed before the next file
+      int version = 0;
+      pclCall(files[k], [&] { return reader.read(files[k], blob, cloud->sensor_origin_, cloud->sensor_orientation_, version); },
+              "cannot parse this PCD file (malformed header or truncated data)");
+      checkCoordinateFields(blob, files[k]);  // every file, not only the first
+      checkBlobSize(blob, files[k]);
+      sensor_points = std::size_t(blob.width) * blob.height;
+      // pcl::fromPCLPointCloud2 indexes point 0 of an empty cloud (PCL 1.13):
+      // what pcl::PCDReader::read<PointT> does, minus that.
+      if (sensor_points > 0) {
+        const Eigen::Vector4f origin = cloud->sensor_origin_;
+        const Eigen::Quaternionf orientation = cloud->sensor_orientation_;
+        pcl::fromPCLPointCloud2(blob, *cloud);
+        cloud->sensor_origin_ = origin;
+        cloud->sensor_orientation_ = orientation;
+      }
     }
-    if (cloud->empty()) out.warnings.push_back(files[k] + ": the cloud has no point; kept as an observation (a group of its own)");
+    if (cloud->empty()) warnings[k] = files[k] + ": the cloud has no point; kept as an observation (a group of its own)";
+    reduced[k] = reduceFrame(*cloud, sensor_points, reduction);
     const Eigen::Isometry3d viewpoint = poseFromSensorOrigin(*cloud);
-    identity_viewpoints += isIdentity(viewpoint);
-    out.observations.push_back({cloud, poses ? (*poses)[k] : viewpoint});
+    identity[k] = isIdentity(viewpoint);
+    out.observations[k] = {cloud, poses ? (*poses)[k] : viewpoint};
+  };
+  readFramesInParallel(files.size(), read, reduction.progress);
+  std::size_t identity_viewpoints = 0;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));
+    out.reduced += reduced[k];
+    identity_viewpoints += identity[k];
   }
   if (!poses && files.size() > 1 && identity_viewpoints == files.size())
     out.warnings.push_back("every PCD VIEWPOINT is absent or the identity and no --poses was given: all "
@@ -192,12 +206,12 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
 
 template PcdSequence<pcl::PointXYZ> loadPcdSequence(const std::vector<std::string>&,
                                                     const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                    const std::string&);
+                                                    const std::string&, const FrameReduction&);
 template PcdSequence<pcl::PointXYZI> loadPcdSequence(const std::vector<std::string>&,
                                                      const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                     const std::string&);
+                                                     const std::string&, const FrameReduction&);
 template PcdSequence<pcl::PointXYZRGB> loadPcdSequence(const std::vector<std::string>&,
                                                        const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                       const std::string&);
+                                                       const std::string&, const FrameReduction&);
 
 }  // namespace obsgroup::io

@@ -10,6 +10,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -194,10 +195,68 @@ void plotPoints(const View& v, const Eigen::Vector3f* begin, const Eigen::Vector
   }
 }
 
+/// `c` shaded for a height `t` in [0, 1] of the band: pale low, full colour high.
+Rgb shadeForHeight(const Rgb& c, double t) {
+  const double white = 0.65 * (1.0 - std::clamp(t, 0.0, 1.0));
+  return {c.r + (1 - c.r) * white, c.g + (1 - c.g) * white, c.b + (1 - c.b) * white};
+}
+
+/// Per pixel, the highest point drawn so far (heights above the sensor, in
+/// the band): a point is drawn over another only from above it.
+class HeightBuffer {
+ public:
+  HeightBuffer(const View& v, const HeightBand& band)
+      : band_(band), width_(v.width), top_(std::size_t(v.width) * v.height, -std::numeric_limits<float>::infinity()) {}
+
+  /// Plots [begin, end), their sensor `height` above the world's zero, in `c`.
+  void plot(const View& v, const Eigen::Vector3f* begin, const Eigen::Vector3f* end, double height, const Rgb& c,
+            int dot, unsigned char* data, int stride) {
+    const double span = band_.high - band_.low;
+    for (const Eigen::Vector3f* p = begin; p != end; ++p) {
+      const double above = p->z() - height;
+      if (!(above >= band_.low && above <= band_.high)) continue;
+      const double fx = v.px(p->x()), fy = v.py(p->y());
+      if (!(fx >= 0 && fy >= 0 && fx < v.width && fy < v.height)) continue;
+      const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+      float& top = top_[std::size_t(y) * width_ + x];
+      if (float(above) <= top) continue;
+      top = float(above);
+      const std::uint32_t argb = argbOf(shadeForHeight(c, span > 0 ? (above - band_.low) / span : 1.0));
+      for (int dy = 0; dy < dot; ++dy)
+        for (int dx = 0; dx < dot; ++dx)
+          if (x + dx < v.width && y + dy < v.height) reinterpret_cast<std::uint32_t*>(data + (y + dy) * stride)[x + dx] = argb;
+    }
+  }
+
+ private:
+  HeightBand band_;
+  int width_;
+  std::vector<float> top_;
+};
+
+/// The points of `world` within the band above their sensor (its height
+/// `heights[i]` in `world`'s frame): what a 3D map is framed and drawn from.
+WorldPoints withinBand(const WorldPoints& world, const std::vector<double>& heights, const HeightBand& band) {
+  WorldPoints kept;
+  kept.origin = world.origin;
+  kept.boxes = world.boxes;
+  kept.offsets.reserve(world.offsets.size());
+  for (int i = 0; i < world.size(); ++i) {
+    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+      const double above = p->z() - heights[std::size_t(i)];
+      if (above >= band.low && above <= band.high) kept.points.push_back(*p);
+    }
+    kept.offsets.push_back(kept.points.size());
+  }
+  return kept;
+}
+
 /// The points coloured by group over the tinted regions when there are some,
-/// on a transparent background above the legend.
+/// on a transparent background above the legend. With a band, each
+/// observation's points are drawn by height above its sensor (`heights`).
 Surface rasterPoints(const WorldPoints& world, const Partition& partition, const MapLayout& layout,
-                     const ObservationRegions* regions) {
+                     const ObservationRegions* regions, const HeightBand* band = nullptr,
+                     const std::vector<double>& heights = {}) {
   View v = layout.view;
   v.height = layout.legend_top;
   Surface surface = imageSurface(v.width, v.height);
@@ -206,9 +265,16 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
   const int stride = cairo_image_surface_get_stride(surface.get());
   if (regions) tintRegions(*regions, partition, layout.colours, v, data, stride);
   const int dot = dotSize(world.points.size());
-  for (int i = 0; i < world.size(); ++i)
-    plotPoints(v, world.begin(i), world.end(i), argbOf(paletteColour(layout.colours[partition.group_of[i]])), dot,
-               data, stride);
+  if (band) {
+    HeightBuffer buffer(v, *band);
+    for (int i = 0; i < world.size(); ++i)
+      buffer.plot(v, world.begin(i), world.end(i), heights[std::size_t(i)],
+                  paletteColour(layout.colours[partition.group_of[i]]), dot, data, stride);
+  } else {
+    for (int i = 0; i < world.size(); ++i)
+      plotPoints(v, world.begin(i), world.end(i), argbOf(paletteColour(layout.colours[partition.group_of[i]])), dot,
+                 data, stride);
+  }
   cairo_surface_mark_dirty(surface.get());
   return surface;
 }
@@ -604,7 +670,7 @@ void drawMemberPoses(cairo_t* cr, const View& v, const LocalMapFrame& frame, con
 /// local_maps/group_NNN.png of one local map, whose points (in its frame)
 /// are given without the non-finite ones.
 void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFrame& frame,
-                          const std::vector<Eigen::Vector3f>& points, const Rgb& colour) {
+                          const std::vector<Eigen::Vector3f>& points, const Rgb& colour, const HeightBand* band) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
   for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
   const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions, 0.005), 700.0, 520, 20);
@@ -613,8 +679,13 @@ void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFra
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
   cairo_paint(cr.get());
   cairo_surface_flush(surface.get());
-  plotPoints(v, points.data(), points.data() + points.size(), argbOf(colour), dotSize(points.size()),
-             cairo_image_surface_get_data(surface.get()), cairo_image_surface_get_stride(surface.get()));
+  unsigned char* data = cairo_image_surface_get_data(surface.get());
+  const int stride = cairo_image_surface_get_stride(surface.get());
+  if (band)  // the map's frame is its reference sensor's: heights above it
+    HeightBuffer(v, *band).plot(v, points.data(), points.data() + points.size(), 0.0, colour, dotSize(points.size()),
+                                data, stride);
+  else
+    plotPoints(v, points.data(), points.data() + points.size(), argbOf(colour), dotSize(points.size()), data, stride);
   cairo_surface_mark_dirty(surface.get());
   drawMemberPoses(cr.get(), v, frame, colour);
   drawScaleBar(cr.get(), v.scale, (v.width - 2 * v.margin) / 5.0, v.width - v.margin, v.margin / 2);
@@ -632,22 +703,23 @@ void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFra
 
 template <typename PointT>
 void writeLocalMapPictures(const PictureWriter& out, const std::vector<LocalMap<PointT>>& maps, int threads,
-                           const std::vector<int>& colours) {
+                           const std::vector<int>& colours, const HeightBand* band) {
   parallelFor(maps.size(), threads, [&](std::size_t g) {
     std::vector<Eigen::Vector3f> points;
     if (maps[g].cloud)
-      for (const PointT& p : finitePoints(*maps[g].cloud).points) points.emplace_back(p.x, p.y, p.z);
+      for (const PointT& p : finitePoints(*maps[g].cloud).points)
+        if (!band || (p.z >= band->low && p.z <= band->high)) points.emplace_back(p.x, p.y, p.z);
     const int colour = g < colours.size() ? colours[g] : static_cast<int>(g);
-    writeLocalMapPicture(out, static_cast<int>(g), maps[g].frame, points, paletteColour(colour));
+    writeLocalMapPicture(out, static_cast<int>(g), maps[g].frame, points, paletteColour(colour), band);
   });
 }
 
 template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZ>>&, int,
-                                    const std::vector<int>&);
+                                    const std::vector<int>&, const HeightBand*);
 template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZI>>&, int,
-                                    const std::vector<int>&);
+                                    const std::vector<int>&, const HeightBand*);
 template void writeLocalMapPictures(const PictureWriter&, const std::vector<LocalMap<pcl::PointXYZRGB>>&, int,
-                                    const std::vector<int>&);
+                                    const std::vector<int>&, const HeightBand*);
 
 MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
                     const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
@@ -661,14 +733,19 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
                       const std::vector<Eigen::Isometry3d>& poses, const std::vector<Eigen::Isometry3d>& drawn,
                       const Partition& partition, const TopologicalMap& topology, const ObservationRegions* regions,
-                      const PlaceMap* places) {
-  const WorldPoints world = atDrawnPoses(input_world, poses, drawn);
+                      const PlaceMap* places, const HeightBand* band) {
+  WorldPoints world = atDrawnPoses(input_world, poses, drawn);
   std::vector<Eigen::Vector2d> positions;
   std::vector<double> headings;
   planarPoses(drawn, world.origin, positions, headings);
+  std::vector<double> heights;  // each sensor's, in the frame of `world`
+  if (band) {
+    for (const auto& pose : drawn) heights.push_back(pose.translation().z() - world.origin.z());
+    world = withinBand(world, heights, *band);
+  }
   const MapLayout layout = layoutOf(world, positions, partition, topology);
   // The regions describe the input poses (they gave W) and stay there.
-  const Surface points = rasterPoints(world, partition, layout, regions);
+  const Surface points = rasterPoints(world, partition, layout, regions, band, heights);
   const auto draw = [&](cairo_surface_t* target) {
     Context cr(cairo_create(target), cairo_destroy);
     drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr, places,

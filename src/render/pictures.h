@@ -53,6 +53,15 @@ struct MapLayout {
   std::size_t points_outside = 0;        ///< Points beyond the crop (not drawn).
 };
 
+/// 3D input seen from above: only the points whose height above their
+/// sensor lies in [low, high] (the visibility model's band, which leaves the
+/// floor and the ceiling out) are drawn, and where several fall on one
+/// pixel the highest is shown, shaded from pale (low) to full colour (high),
+/// so that walls, furniture and doors read as on a floor plan.
+struct HeightBand {
+  double low = 0.0, high = 0.0;
+};
+
 /// The layout writeMapPictures() uses for these arguments.
 MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
                     const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
@@ -71,11 +80,12 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 /// its points moved by drawn[i] * poses[i]^-1. The regions are drawn where
 /// they were computed, at the input poses. With places (place k of group k),
 /// each place's outline is drawn in its group's colour and each door as a
-/// short black bar, where they were computed (at the input poses).
+/// short black bar, where they were computed (at the input poses). With a
+/// height band (3D input), only the points within it are drawn and framed.
 void writeMapPictures(const PictureWriter& out, const WorldPoints& world, const std::vector<Eigen::Isometry3d>& poses,
                       const std::vector<Eigen::Isometry3d>& drawn, const Partition& partition,
                       const TopologicalMap& topology, const ObservationRegions* regions = nullptr,
-                      const PlaceMap* places = nullptr);
+                      const PlaceMap* places = nullptr, const HeightBand* band = nullptr);
 
 /// local_maps/group_NNN.png, numbered like writeLocalMaps' PCD files: each
 /// local map's merged points from above in the map's own frame (x right, y
@@ -84,10 +94,11 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& world, const 
 /// either end on each axis: fewer are far returns than in map.png); about
 /// 780 px on the long side. Group g is drawn in colour `colours[g]`
 /// (groupColours(), as in map.png; empty: g). Written on `threads` threads
-/// (<= 0: all); each picture is the same for any number.
+/// (<= 0: all); each picture is the same for any number. With a height band
+/// (3D input), heights are taken above the map's reference sensor.
 template <typename PointT>
 void writeLocalMapPictures(const PictureWriter& out, const std::vector<LocalMap<PointT>>& maps, int threads = 0,
-                           const std::vector<int>& colours = {});
+                           const std::vector<int>& colours = {}, const HeightBand* band = nullptr);
 
 /// weights.png: W as an image, rows and columns ordered by group, darker for
 /// a larger overlap, each group boxed.

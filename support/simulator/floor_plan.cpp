@@ -155,6 +155,33 @@ std::vector<Eigen::Vector3d> FloorPlan::depthImage(const Pose2D& pose, const Dep
   return points;
 }
 
+std::vector<Eigen::Vector3d> FloorPlan::lidarSweep(const Pose2D& pose, const Lidar& lidar, std::uint64_t seed) const {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, lidar.range_noise > 0 ? lidar.range_noise : 1.0);
+  const double h = lidar.height_above_floor;
+  const double step = lidar.rings > 1 ? (lidar.highest - lidar.lowest) / (lidar.rings - 1) : 0.0;
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(std::size_t(lidar.rings) * lidar.columns);
+  for (int c = 0; c < lidar.columns; ++c) {
+    // A column of beams shares one azimuth: one 2D cast per column.
+    const double azimuth = 2.0 * 3.14159265358979323846 * c / lidar.columns;
+    const double wall = castHorizontal({pose.x, pose.y}, pose.yaw + azimuth, lidar.max_range);
+    for (int r = 0; r < lidar.rings; ++r) {
+      const double elevation = lidar.lowest + r * step;
+      const Eigen::Vector3d ray(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
+                                std::sin(elevation));
+      double s = wall / ray.head<2>().norm();
+      const double z = h + s * ray.z();
+      if (z < 0.0) s = h / -ray.z();
+      else if (z > ceiling_) s = (ceiling_ - h) / ray.z();
+      const double n = lidar.range_noise > 0 ? noise(rng) : 0.0;
+      if (!(s + n < lidar.max_range) || !(s + n > 0)) continue;
+      points.push_back(ray * (s + n));
+    }
+  }
+  return points;
+}
+
 double FloorPlan::clearanceAt(double x, double y, double max_distance) const {
   double nearest = max_distance;
   for (int degree = 0; degree < 360; ++degree)

@@ -48,6 +48,18 @@ struct DepthCamera {
   double range_noise = 0.0;         ///< Gaussian sigma along the ray, metres
 };
 
+/// A spinning multi-beam lidar (a Velodyne HDL-64E's geometry): `rings`
+/// beams spread evenly over [lowest, highest] elevation, each fired at
+/// `columns` azimuths over a full turn. Points in the sensor frame.
+struct Lidar {
+  int rings = 64, columns = 1875;  ///< 120,000 beams a sweep
+  double lowest = -24.9 * 3.14159265358979323846 / 180.0;
+  double highest = 2.0 * 3.14159265358979323846 / 180.0;
+  double height_above_floor = 1.7;  ///< metres
+  double max_range = 80.0;          ///< metres; no point beyond
+  double range_noise = 0.0;         ///< Gaussian sigma along the ray, metres
+};
+
 class FloorPlan {
  public:
   /// A solid axis-aligned box (a wall segment, a pillar, a cupboard).
@@ -71,6 +83,10 @@ class FloorPlan {
   /// (z = 0) to the ceiling; floor and ceiling are seen too.
   std::vector<Eigen::Vector3d> depthImage(const Pose2D& pose, const DepthCamera& camera,
                                           std::uint64_t seed = 0) const;
+  /// Points of one lidar sweep in the sensor frame (x ahead, y left, z up),
+  /// the lidar at `lidar.height_above_floor` over `pose`; walls, floor and
+  /// ceiling as for depthImage.
+  std::vector<Eigen::Vector3d> lidarSweep(const Pose2D& pose, const Lidar& lidar, std::uint64_t seed = 0) const;
   void setCeilingHeight(double height) { ceiling_ = height; }
 
   /// The box of a room given to addRoom.

@@ -11,6 +11,7 @@
 // same points in the world, and the local maps and pose arrows then read as
 // from above.
 
+#include "obsgroup/io/frame_reduction.h"
 #include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
@@ -92,6 +93,9 @@ struct DepthOptions {
   /// The world's up axis; default: z for TUM (its motion-capture world has
   /// z up), Auto for Redwood.
   std::optional<UpAxis> up;
+  /// Each frame's reduction as it is read (a frame's sensor points: the
+  /// image's pixels / stride^2), and the progress of the read.
+  FrameReduction reduction;
 };
 
 /// The points of an image; value 0 is no return, as is a depth beyond
@@ -115,12 +119,15 @@ struct DepthSequence {
   std::vector<std::string> labels;  ///< the PNG of each observation
   std::vector<std::string> warnings;
   std::size_t skipped = 0;  ///< TUM frames without a pose within the tolerance
+  std::size_t reduced = 0;  ///< frames voxel-filtered as they were read
   UpAxis up = UpAxis::PlusZ;  ///< the trajectory's up axis (the world was turned to put it on z)
 };
 
 /// Reads the folder in `layout`. TUM: frames without a groundtruth pose
 /// within the tolerance are skipped (one warning with the count). Redwood:
-/// fewer trajectory entries than images is an error.
+/// fewer trajectory entries than images is an error. Frames are decoded on
+/// every thread, each reduced as options.reduction says before the next is
+/// read, so that peak memory grows with the reduced frames.
 DepthSequence loadDepthSequence(const std::string& folder, DepthLayout layout, const DepthOptions& options);
 
 }  // namespace obsgroup::io

@@ -5,6 +5,8 @@
 // the world is the first velodyne frame (x ahead, y left, z up), not camera
 // 0's (z ahead, y down), so that z is up as obsgroup assumes.
 
+#include "obsgroup/io/frame_reduction.h"
+
 #include <obsgroup/cloud/observation.h>
 
 #include <pcl/point_types.h>
@@ -33,10 +35,14 @@ struct KittiSequence {
   std::vector<std::string> warnings;
   std::string poses_file;
   std::string calib_file;
+  std::size_t reduced = 0;  ///< scans voxel-filtered as they were read
 };
 
 /// Reads the folder; `poses` replaces its poses.txt. One pose per scan in
-/// name order: a different count is an error.
-KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses);
+/// name order: a different count is an error. Scans are decoded on every
+/// thread, each reduced as `reduction` says (its sensor points: the scan's)
+/// before the next is read.
+KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses,
+                                const FrameReduction& reduction = {});
 
 }  // namespace obsgroup::io

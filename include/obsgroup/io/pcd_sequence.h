@@ -2,6 +2,7 @@
 // A folder of PCD files as a sequence of observations, each posed by its
 // VIEWPOINT or by a trajectory file.
 
+#include "obsgroup/io/frame_reduction.h"
 #include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
@@ -44,16 +45,19 @@ template <typename PointT>
 struct PcdSequence {
   std::vector<Observation<PointT>> observations;
   std::vector<std::string> warnings;
+  std::size_t reduced = 0;  ///< clouds voxel-filtered as they were read
 };
 
 /// Loads every file. Poses come from `poses` when given (one per file, in
 /// order), else from each file's VIEWPOINT. Throws InputError naming the PCD
 /// file that cannot be parsed or is truncated, or a poses count that does
 /// not match; warns about empty clouds and about VIEWPOINTs that are all the
-/// identity.
+/// identity. Files are read on every thread, each cloud reduced as
+/// `reduction` says (its sensor points: width x height of the file) before
+/// the next is read.
 template <typename PointT>
 PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
                                     const std::optional<std::vector<Eigen::Isometry3d>>& poses,
-                                    const std::string& poses_file = "");
+                                    const std::string& poses_file = "", const FrameReduction& reduction = {});
 
 }  // namespace obsgroup::io

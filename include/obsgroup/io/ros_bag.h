@@ -7,6 +7,7 @@
 // bags in the default sqlite3 storage (a folder with metadata.yaml and
 // *.db3) with SQLite and Fast CDR. Neither needs a ROS installation.
 
+#include "obsgroup/io/frame_reduction.h"
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
 #include <obsgroup/io/pcd_sequence.h>
@@ -41,6 +42,9 @@ struct BagOptions {
   /// max_time_difference, as a SLAM system's output would give it.
   std::optional<std::string> poses_file;
   double max_time_difference = kDefaultMaxTimeDifference;  ///< seconds
+  /// Each PointCloud2's reduction as it is converted (its sensor points:
+  /// width x height), and the progress over the messages.
+  FrameReduction reduction;
 };
 
 /// The observations of a bag, with what was read and how.
@@ -55,6 +59,7 @@ struct BagSequenceOf {
   std::string message_type;  ///< sensor_msgs/LaserScan or sensor_msgs/PointCloud2
   std::string pose_source;   ///< "/tf", the pose topic or the poses file
   std::string fixed_frame;   ///< the frame of the poses ("" for a poses file: its own)
+  std::size_t reduced = 0;   ///< clouds voxel-filtered as they were converted
   std::size_t skipped = 0;   ///< messages with no pose at their stamp (outside the poses' time span, or none in the file within the tolerance)
 };
 using BagSequence = BagSequenceOf<pcl::PointXYZ>;

@@ -1,0 +1,107 @@
+#include "obsgroup/io/frame_reduction.h"
+
+#include <pcl/common/common.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/point_types.h>
+
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace obsgroup::io {
+
+namespace {
+
+/// The voxels VoxelGrid would index for points within [lo, hi], leaf `leaf`.
+double voxelCount(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, double leaf) {
+  double count = 1.0;
+  for (int a = 0; a < 3; ++a) count *= std::floor(double(hi[a]) / leaf) - std::floor(double(lo[a]) / leaf) + 1.0;
+  return count;
+}
+
+/// Appends the voxel centroids of `points` to `out`. VoxelGrid's voxels sit on
+/// multiples of the leaf in the cloud's frame, whatever the cloud's extent, so
+/// the halves of a cloud cut on a voxel boundary give the voxels of the whole.
+template <typename PointT>
+void filterInParts(const pcl::PointCloud<PointT>& points, double leaf, pcl::PointCloud<PointT>& out) {
+  if (points.empty()) return;
+  Eigen::Vector4f lo, hi;
+  pcl::getMinMax3D(points, lo, hi);
+  if (voxelCount(lo.head<3>(), hi.head<3>(), leaf) < double(std::numeric_limits<std::int32_t>::max())) {
+    pcl::VoxelGrid<PointT> grid;
+    grid.setLeafSize(float(leaf), float(leaf), float(leaf));
+    grid.setInputCloud(typename pcl::PointCloud<PointT>::ConstPtr(&points, [](const pcl::PointCloud<PointT>*) {}));
+    pcl::PointCloud<PointT> part;
+    grid.filter(part);
+    out.insert(out.end(), part.begin(), part.end());
+    return;
+  }
+  Eigen::Index axis = 0;
+  (hi - lo).head<3>().maxCoeff(&axis);
+  // The voxel index VoxelGrid gives a coordinate is floor(c / leaf): cut between two of them.
+  const double first = std::floor(double(lo[axis]) / leaf), last = std::floor(double(hi[axis]) / leaf);
+  const double cut = std::floor((first + last) / 2.0);
+  pcl::PointCloud<PointT> below, above;
+  for (const PointT& p : points) (std::floor(double(p.data[axis]) / leaf) <= cut ? below : above).push_back(p);
+  filterInParts(below, leaf, out);
+  filterInParts(above, leaf, out);
+}
+
+}  // namespace
+
+void readFramesInParallel(std::size_t count, const std::function<void(std::size_t)>& read,
+                          const std::function<void(std::size_t, std::size_t)>& progress) {
+  const std::int64_t n = static_cast<std::int64_t>(count);
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::int64_t> first_failed{n};
+  std::atomic<std::size_t> done{0};
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t k = 0; k < n; ++k) {
+    if (k > first_failed.load()) continue;
+    try {
+      read(std::size_t(k));
+    } catch (...) {
+      errors[std::size_t(k)] = std::current_exception();
+      for (std::int64_t seen = first_failed.load(); k < seen && !first_failed.compare_exchange_weak(seen, k);) {
+      }
+    }
+    const std::size_t frames = ++done;
+    if (progress) {
+#pragma omp critical(obsgroup_frame_progress)
+      progress(frames, count);
+    }
+  }
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
+}
+
+template <typename PointT>
+bool reduceFrame(pcl::PointCloud<PointT>& cloud, std::size_t sensor_points, const FrameReduction& reduction) {
+  if (!reduction.reduces(sensor_points)) return false;
+  pcl::PointCloud<PointT> finite;
+  finite.reserve(cloud.size());
+  for (const PointT& p : cloud)
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) finite.push_back(p);
+  pcl::PointCloud<PointT> reduced;
+  filterInParts(finite, reduction.voxel_leaf, reduced);
+  const Eigen::Vector4f origin = cloud.sensor_origin_;
+  const Eigen::Quaternionf orientation = cloud.sensor_orientation_;
+  const auto header = cloud.header;
+  cloud.swap(reduced);
+  cloud.width = static_cast<std::uint32_t>(cloud.size());
+  cloud.height = 1;
+  cloud.is_dense = true;
+  cloud.sensor_origin_ = origin;
+  cloud.sensor_orientation_ = orientation;
+  cloud.header = header;
+  return true;
+}
+
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZ>&, std::size_t, const FrameReduction&);
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZI>&, std::size_t, const FrameReduction&);
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZRGB>&, std::size_t, const FrameReduction&);
+
+}  // namespace obsgroup::io
