@@ -116,7 +116,8 @@ struct Dataset {
 /// sensor and shared (the clouds are reference counted) by its exact and
 /// drifted datasets, which differ only in the poses.
 std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, const std::vector<sim::Sensor>& sensors,
-                                  const std::vector<PoseSource>& pose_sources) {
+                                  const std::vector<PoseSource>& pose_sources,
+                                  const sim::DepthCamera& depth_camera = sim::depthCamera()) {
   std::vector<Dataset> datasets;
   for (const std::string& key : buildings) {
     const sim::Building building = sim::makeBuilding(key);
@@ -130,7 +131,7 @@ std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, con
     for (sim::Sensor sensor : sensors) {
       // The sensor frame's height: a depth camera stands over the floor, a
       // laser scans in the plane z = 0.
-      const double height = sensor == sim::Sensor::Depth ? sim::depthCamera().height_above_floor : 0.0;
+      const double height = sim::sensorHeight(sensor);
       std::vector<Cloud::ConstPtr> clouds;
       std::vector<Eigen::Isometry3d> truth;
       std::size_t points = 0;
@@ -145,7 +146,10 @@ std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, con
             cloud = sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser180(), k);
             break;
           case sim::Sensor::Depth:
-            cloud = sim::depthCloud<pcl::PointXYZ>(building.plan, pose, sim::depthCamera(), k);
+            cloud = sim::depthCloud<pcl::PointXYZ>(building.plan, pose, depth_camera, k);
+            break;
+          case sim::Sensor::Lidar:
+            cloud = sim::lidarCloud<pcl::PointXYZ>(building.plan, pose, sim::lidar(), k);
             break;
         }
         points += cloud->size();
@@ -183,6 +187,10 @@ struct Configuration {
   double ncut_threshold = GroupingParameters{}.ncut_threshold;
   int boundary_passes = GroupingParameters{}.boundary_passes;
   int threads = 0;  ///< 0: all cores
+  /// Voxel leaf of each observation (0: every point); the command reduces
+  /// dense frames at io::kDefaultFrameVoxel with the same pcl::VoxelGrid in
+  /// the sensor frame as they are read.
+  double voxel_leaf = 0.0;
 
   /// The page's row label: the model (with δ for points) and the split; the
   /// region parameters are common to all rows and stated once.
@@ -241,6 +249,7 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
   params.ncut_threshold = c.ncut_threshold;
   params.boundary_passes = c.boundary_passes;
   params.threads = c.threads;
+  params.voxel_leaf = c.voxel_leaf;
   grouping.setParameters(params);
   Partition p = grouping.compute();
   if (warnings) *warnings = grouping.getWarnings().size();
@@ -363,7 +372,7 @@ int writeLogs(const std::string& folder, const std::vector<std::string>& buildin
     for (const sim::Pose2D& pose : building.route) truth.push_back(sim::toIsometry(pose));
     const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
     for (sim::Sensor sensor : sensors) {
-      if (sensor == sim::Sensor::Depth) continue;  // not a CARMEN log
+      if (sensor == sim::Sensor::Depth || sensor == sim::Sensor::Lidar) continue;  // not a CARMEN log
       const sim::LaserModel laser = sensor == sim::Sensor::Laser360 ? sim::laser360() : sim::laser180();
       const double step = laser.full_turn ? laser.field_of_view / laser.beams : laser.field_of_view / (laser.beams - 1);
       for (PoseSource source : pose_sources) {
@@ -638,9 +647,10 @@ const char* kUsage =
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
-    "  --threads N (0: all cores)\n"
+    "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
+    "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
     "selection (defaults: all):\n"
-    "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth  --poses exact,drift\n"
+    "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth[,lidar]  --poses exact,drift\n"
     "real logs instead of the simulated buildings (each --log with its --labels, in order):\n"
     "  --log LOG --labels LABELS.json\n"
     "the selected laser datasets as CARMEN logs with their labels, for obsgroup partition and --log:\n"
@@ -660,6 +670,7 @@ int main(int argc, char** argv) {
   std::vector<PoseSource> pose_sources{PoseSource::Exact, PoseSource::Drift};
   std::vector<std::string> logs, label_files;
   std::string write_logs;
+  sim::DepthCamera depth_camera = sim::depthCamera();
   bool sweep = false;
   try {
     RegionParameters& region = configuration.region;
@@ -685,6 +696,14 @@ int main(int argc, char** argv) {
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--boundary-passes", integer(configuration.boundary_passes)},
         {"--threads", integer(configuration.threads)},
+        {"--voxel", number(configuration.voxel_leaf)},
+        {"--depth-size",
+         [&](const std::string& flag, const std::string& v) {
+           const auto x = v.find('x');
+           if (x == std::string::npos) throw std::invalid_argument(flag + " takes WIDTHxHEIGHT");
+           depth_camera.width = parseInteger(flag, v.substr(0, x));
+           depth_camera.height = parseInteger(flag, v.substr(x + 1));
+         }},
         {"--write-logs", [&](const std::string&, const std::string& v) { write_logs = v; }},
         {"--sweep",
          [&](const std::string& flag, const std::string& v) {
@@ -753,7 +772,7 @@ int main(int argc, char** argv) {
   }
 
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<Dataset> datasets = makeDatasets(buildings, sensors, pose_sources);
+  const std::vector<Dataset> datasets = makeDatasets(buildings, sensors, pose_sources, depth_camera);
   const double generation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if (sweep) {

@@ -95,6 +95,7 @@ Cloud::ConstPtr scanAt(const sim::FloorPlan& plan, const sim::Pose2D& pose, sim:
     case sim::Sensor::Laser360: return sim::scanCloud<pcl::PointXYZ>(plan, pose, sim::laser360(), seed);
     case sim::Sensor::Laser180: return sim::scanCloud<pcl::PointXYZ>(plan, pose, sim::laser180(), seed);
     case sim::Sensor::Depth: return sim::depthCloud<pcl::PointXYZ>(plan, pose, depthCamera(), seed);
+    case sim::Sensor::Lidar: return sim::lidarCloud<pcl::PointXYZ>(plan, pose, sim::lidar(), seed);
   }
   throw std::logic_error("unknown sensor");
 }
@@ -110,7 +111,7 @@ void checkClearance(const sim::FloorPlan& plan, const std::vector<sim::Pose2D>& 
 Run simulate(const sim::FloorPlan& plan, const std::vector<sim::Pose2D>& route, sim::Sensor sensor,
              std::uint64_t first_seed) {
   // A depth camera stands over the floor; a laser scans in the plane z = 0.
-  const double height = sensor == sim::Sensor::Depth ? depthCamera().height_above_floor : 0.0;
+  const double height = sensor == sim::Sensor::Depth ? depthCamera().height_above_floor : sim::sensorHeight(sensor);
   Run run;
   for (std::size_t k = 0; k < route.size(); ++k) {
     run.clouds.push_back(scanAt(plan, route[k], sensor, first_seed + k));

@@ -50,6 +50,8 @@ Cloud::ConstPtr cloudOf(const sim::Building& b, const sim::Pose2D& pose, sim::Se
       return sim::scanCloud<pcl::PointXYZ>(b.plan, pose, sim::laser360(), seed);
     case sim::Sensor::Laser180:
       return sim::scanCloud<pcl::PointXYZ>(b.plan, pose, sim::laser180(), seed);
+    case sim::Sensor::Lidar:
+      return sim::lidarCloud<pcl::PointXYZ>(b.plan, pose, sim::lidar(), seed);
     case sim::Sensor::Depth:
       break;
   }
@@ -89,7 +91,7 @@ void segmentationScore(const std::map<int, std::map<int, std::size_t>>& overlap,
 Score evaluate(const sim::Building& b, sim::Sensor sensor, bool drifted) {
   Score s;
   s.label = b.title + "; " + sim::describe(sensor) + ", " + (drifted ? "drifted" : "exact") + " poses";
-  const double height = sensor == sim::Sensor::Depth ? sim::depthCamera().height_above_floor : 0.0;
+  const double height = sim::sensorHeight(sensor);
   std::vector<Eigen::Isometry3d> truth;
   for (const auto& pose : b.route) truth.push_back(sim::toIsometry(pose, height));
   const std::vector<Eigen::Isometry3d> poses = drifted ? sim::drift(truth, kDriftSeed) : truth;

@@ -65,13 +65,14 @@ Dataset makeDataset(const std::string& key, sim::Sensor sensor) {
   const sim::Building building = sim::makeBuilding(key);
   Dataset d;
   d.title = building.title + ", " + sim::describe(sensor);
-  const double height = sensor == sim::Sensor::Depth ? sim::depthCamera().height_above_floor : 0.0;
+  const double height = sim::sensorHeight(sensor);
   for (std::size_t k = 0; k < building.route.size(); ++k) {
     const sim::Pose2D& pose = building.route[k];
     switch (sensor) {
       case sim::Sensor::Laser360: d.clouds.push_back(sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser360(), k)); break;
       case sim::Sensor::Laser180: d.clouds.push_back(sim::scanCloud<pcl::PointXYZ>(building.plan, pose, sim::laser180(), k)); break;
       case sim::Sensor::Depth: d.clouds.push_back(sim::depthCloud<pcl::PointXYZ>(building.plan, pose, sim::depthCamera(), k)); break;
+      case sim::Sensor::Lidar: d.clouds.push_back(sim::lidarCloud<pcl::PointXYZ>(building.plan, pose, sim::lidar(), k)); break;
     }
     d.truth.push_back(sim::toIsometry(pose, height));
   }

@@ -38,14 +38,15 @@ std::string toString(Sensor sensor) {
     case Sensor::Laser360: return "laser360";
     case Sensor::Laser180: return "laser180";
     case Sensor::Depth: return "depth";
+    case Sensor::Lidar: return "lidar";
   }
   return "?";
 }
 
 Sensor sensorFromString(const std::string& name) {
-  for (Sensor s : {Sensor::Laser360, Sensor::Laser180, Sensor::Depth})
+  for (Sensor s : {Sensor::Laser360, Sensor::Laser180, Sensor::Depth, Sensor::Lidar})
     if (toString(s) == name) return s;
-  throw std::invalid_argument("unknown sensor '" + name + "' (laser360, laser180 or depth)");
+  throw std::invalid_argument("unknown sensor '" + name + "' (laser360, laser180, depth or lidar)");
 }
 
 std::string describe(Sensor sensor) {
@@ -53,6 +54,7 @@ std::string describe(Sensor sensor) {
     case Sensor::Laser360: return "360° laser";
     case Sensor::Laser180: return "forward 180° laser";
     case Sensor::Depth: return "depth camera";
+    case Sensor::Lidar: return "64-beam lidar";
   }
   return "?";
 }
@@ -67,6 +69,22 @@ LaserModel laser180() {
   LaserModel laser;
   laser.range_noise = 0.01;
   return laser;
+}
+
+Lidar lidar() {
+  Lidar l;
+  l.range_noise = 0.01;
+  return l;
+}
+
+double sensorHeight(Sensor sensor) {
+  switch (sensor) {
+    case Sensor::Depth: return depthCamera().height_above_floor;
+    case Sensor::Lidar: return lidar().height_above_floor;
+    case Sensor::Laser360:
+    case Sensor::Laser180: break;
+  }
+  return 0.0;
 }
 
 DepthCamera depthCamera() {

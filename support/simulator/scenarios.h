@@ -38,9 +38,10 @@ std::vector<std::string> buildingKeys();
 enum class Sensor {
   Laser360,  ///< fullTurnLaser(): 720 beams, 30 m
   Laser180,  ///< the default LaserModel: forward 180 degrees, 361 beams, 30 m
-  Depth      ///< the default DepthCamera: 80 x 60 pixels, 58 degrees, 6 m, 1 m over the floor
+  Depth,     ///< the default DepthCamera: 80 x 60 pixels, 58 degrees, 6 m, 1 m over the floor
+  Lidar      ///< lidar(): a 64-beam spinning lidar, 120,000 beams a sweep, 1.7 m over the floor
 };
-std::string toString(Sensor sensor);  ///< "laser360", "laser180", "depth"
+std::string toString(Sensor sensor);  ///< "laser360", "laser180", "depth", "lidar"
 /// Parses the names of toString; throws std::invalid_argument otherwise.
 Sensor sensorFromString(const std::string& name);
 /// A few words for reports: "360° laser" and so on.
@@ -49,6 +50,10 @@ std::string describe(Sensor sensor);
 LaserModel laser360();
 LaserModel laser180();
 DepthCamera depthCamera();
+Lidar lidar();
+/// The height of the sensor frame over the floor: a depth camera and a lidar
+/// stand over it, a laser scans in the plane z = 0.
+double sensorHeight(Sensor sensor);
 
 /// The true place of every pose of a route: the plan's rooms, except that a
 /// corridor (a room whose name contains "corridor") is cut along its length

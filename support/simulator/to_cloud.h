@@ -50,4 +50,24 @@ typename pcl::PointCloud<PointT>::Ptr depthCloud(const FloorPlan& plan, const Po
   return cloud;
 }
 
+/// One lidar sweep as a cloud in the sensor frame (x ahead, y left, z up),
+/// its sensor origin `lidar.height_above_floor` over the pose.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr lidarCloud(const FloorPlan& plan, const Pose2D& pose, const Lidar& lidar,
+                                                 std::uint64_t seed) {
+  typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
+  const auto points = plan.lidarSweep(pose, lidar, seed);
+  cloud->reserve(points.size());
+  for (const auto& q : points) {
+    PointT p;
+    p.x = static_cast<float>(q.x());
+    p.y = static_cast<float>(q.y());
+    p.z = static_cast<float>(q.z());
+    cloud->push_back(p);
+  }
+  cloud->sensor_origin_ << float(pose.x), float(pose.y), float(lidar.height_above_floor), 0.0f;
+  cloud->sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(pose.yaw), Eigen::Vector3f::UnitZ()));
+  return cloud;
+}
+
 }  // namespace obsgroup::sim
