@@ -319,6 +319,47 @@ TEST_F(Ros1Bag, PointCloudsKeepTheirFiniteXyzAcrossPaddedRows) {
   expectPose(read.observations[0].pose, planar(1, 2, 0));
 }
 
+TEST_F(Ros1Bag, DenseCloudsAreReducedAsTheyAreDecoded) {
+  {
+    rosbag::Bag bag(path(), rosbag::bagmode::Write);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transformMessage("map", "lidar", 5, planar(0, 0, 0)));
+    tf.transforms.push_back(transformMessage("map", "lidar", 7, planar(1, 0, 0)));
+    bag.write("/tf", rosTime(5), tf);
+    for (double stamp : {5.0, 6.0}) {
+      // 200 x 120 points (dense) on a 4 x 2.4 m wall 2 m ahead, rows padded by 4 bytes.
+      sensor_msgs::PointCloud2 cloud = floatCloud("lidar", stamp, {"x", "y", "z"});
+      cloud.height = 120;
+      cloud.width = 200;
+      cloud.row_step = cloud.width * cloud.point_step + 4;
+      cloud.data.assign(cloud.row_step * cloud.height, 0);
+      for (std::uint32_t v = 0; v < cloud.height; ++v)
+        for (std::uint32_t u = 0; u < cloud.width; ++u) {
+          const float point[3] = {2.0f, 0.02f * float(u) - 2.0f, 0.02f * float(v) - 1.2f};
+          std::memcpy(&cloud.data[v * cloud.row_step + u * cloud.point_step], point, sizeof point);
+        }
+      bag.write("/points", rosTime(stamp), cloud);
+    }
+  }
+  const BagSequence whole = loadBag(path(), BagVersion::Ros1);
+  ASSERT_EQ(whole.observations.size(), 2u);
+  EXPECT_EQ(whole.observations[0].cloud->size(), 24000u);
+  EXPECT_EQ(whole.reduced, 0u);
+  BagOptions options;
+  options.reduction = FrameReduction::denseDefault();
+  const BagSequence reduced = loadBag(path(), BagVersion::Ros1, options);
+  EXPECT_EQ(reduced.reduced, 2u);
+  ASSERT_EQ(reduced.observations.size(), 2u);
+  // About 80 x 48 voxels of 5 cm, each within the wall's extent.
+  EXPECT_GT(reduced.observations[0].cloud->size(), 3000u);
+  EXPECT_LT(reduced.observations[0].cloud->size(), 5000u);
+  for (const auto& p : *reduced.observations[1].cloud) {
+    EXPECT_NEAR(p.x, 2.0f, 1e-4f);
+    EXPECT_GE(p.y, -2.0f);
+    EXPECT_LE(p.y, 2.0f);
+  }
+}
+
 TEST_F(Ros1Bag, CloudsInAnOpticalFrameAreTurnedIntoTheBodyFrame) {
   {
     rosbag::Bag bag(path(), rosbag::bagmode::Write);

@@ -1299,6 +1299,43 @@ TEST_F(Cli, BagOptionsAndBadBags) {
 // ---------------------------------------------------------------------------
 // Depth image sequences, KITTI odometry and TUM poses matched by timestamp.
 
+TEST_F(Cli, KeyframesAreGroupedAndEveryOtherFrameTakesItsKeyframesPlace) {
+  const std::string input = kData + "/office_3d/pcd";
+  const Result r = run("partition " + input + " -q --no-pictures --keyframes 3,60 -o " + (dir_ / "k").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json p = expectPartitionSchema(dir_ / "k", 40);
+  const auto keyframe_of = p.at("keyframe_of").get<std::vector<int>>();
+  ASSERT_EQ(keyframe_of.size(), 40u);
+  const std::size_t keyframes = p.at("statistics").at("keyframes").get<std::size_t>();
+  EXPECT_LT(keyframes, 40u);
+  EXPECT_GT(keyframes, 5u);
+  EXPECT_EQ(p.at("parameters").at("keyframes").at("distance"), 3.0);
+  // Every frame is in the group of its keyframe, and places.json lists it there too.
+  std::vector<int> group_of(40, -1);
+  const auto groups = p.at("groups").get<std::vector<std::vector<int>>>();
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int i : groups[g]) group_of[std::size_t(i)] = int(g);
+  for (int i = 0; i < 40; ++i) {
+    ASSERT_GE(group_of[std::size_t(i)], 0) << i;
+    EXPECT_LE(keyframe_of[std::size_t(i)], i);
+    EXPECT_EQ(group_of[std::size_t(i)], group_of[std::size_t(keyframe_of[std::size_t(i)])]) << i;
+  }
+  std::size_t listed = 0;
+  const nlohmann::json places = readJson(dir_ / "k" / "places.json");
+  for (const auto& place : places.at("places")) listed += place.at("members").size();
+  EXPECT_EQ(listed, 40u);
+  EXPECT_TRUE(readJson(dir_ / "k" / "partition.json").at("sources").size() == 40u);
+  // Without the option every frame is grouped and keyframe_of is null.
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "all").string()).code, 0);
+  EXPECT_TRUE(readJson(dir_ / "all" / "partition.json").at("keyframe_of").is_null());
+  for (const char* bad : {"3", "-1,5", "1,x", "nan,5"}) {
+    const Result refused = run("partition " + input + " --keyframes " + bad + " -o " + (dir_ / "x").string());
+    EXPECT_EQ(refused.code, 2) << bad;
+    EXPECT_NE(refused.err.find("DIST,ANGLE"), std::string::npos) << refused.err;
+  }
+  EXPECT_EQ(run("stream " + input + " --keyframes 3,60 -o " + (dir_ / "x").string()).code, 2);  // every frame online
+}
+
 TEST_F(Cli, SimulatedDepthImagesGroupAsTheSamePcdSequence) {
   // The office_3d run written as TUM RGB-D: 16-bit PNGs in the optical frame.
   const fs::path tum = dir_ / "tum";

@@ -3,6 +3,7 @@
 #include "test_support.h"
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/partition/keyframes.h>
 
 #include <gtest/gtest.h>
 
@@ -219,4 +220,38 @@ TEST(RecursivePartition, BoundaryRefinementKeepsTheMinimumGroupSize) {
     for (const auto& g : p.groups) EXPECT_GE(int(g.size()), min_size) << "minimum " << min_size;
     expectWellFormed(p, int(obs.size()));
   }
+}
+
+TEST(Keyframes, AFrameIsAKeyframeWhenItMovedOrTurnedEnoughSinceTheLast) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int k = 0; k < 8; ++k) poses.push_back(pose2D(0.04 * k, 0.0, 0.0));  // 4 cm a frame
+  EXPECT_EQ(selectKeyframes(poses, {0.1, 90.0}), (std::vector<int>{0, 0, 0, 3, 3, 3, 6, 6}));
+  std::vector<Eigen::Isometry3d> turning;
+  for (int k = 0; k < 7; ++k) turning.push_back(pose2D(1.0, 2.0, k * 2.0 * M_PI / 180.0));  // 2 degrees a frame
+  EXPECT_EQ(selectKeyframes(turning, {1.0, 5.0}), (std::vector<int>{0, 0, 0, 3, 3, 3, 6}));
+  EXPECT_EQ(selectKeyframes(turning, {0.0, 0.0}), (std::vector<int>{0, 1, 2, 3, 4, 5, 6}));  // every frame
+  EXPECT_EQ(keyframesOf({0, 0, 0, 3, 3, 3, 6}), (std::vector<int>{0, 3, 6}));
+  EXPECT_TRUE(selectKeyframes({}, {0.1, 5.0}).empty());
+  EXPECT_THROW(selectKeyframes(poses, {-0.1, 5.0}), std::invalid_argument);
+  EXPECT_THROW(selectKeyframes(poses, {0.1, std::nan("")}), std::invalid_argument);
+}
+
+TEST(Keyframes, EveryFrameTakesTheGroupOfItsKeyframe) {
+  // Frames 0..5, keyframes 0, 2, 3; the keyframes grouped {0, 2} (frames 0 and 3) and {1} (frame 2).
+  const std::vector<int> keyframe_of{0, 0, 2, 3, 3, 3};
+  Partition of_keyframes;
+  of_keyframes.groups = {{0, 2}, {1}};
+  of_keyframes.group_of = {0, 1, 0};
+  SplitNode root;
+  root.members = {0, 1, 2};
+  root.eigenvector = Eigen::VectorXd::Ones(3);
+  of_keyframes.splits = {root};
+  of_keyframes.warnings = {"kept"};
+  const Partition every = expandKeyframePartition(of_keyframes, keyframe_of);
+  EXPECT_EQ(every.groups, (std::vector<std::vector<int>>{{0, 1, 3, 4, 5}, {2}}));
+  EXPECT_EQ(every.group_of, (std::vector<int>{0, 0, 1, 0, 0, 0}));
+  ASSERT_EQ(every.splits.size(), 1u);
+  EXPECT_EQ(every.splits[0].members, (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(every.splits[0].eigenvector.size(), 0);
+  EXPECT_EQ(every.warnings, of_keyframes.warnings);
 }

@@ -10,6 +10,8 @@
 #include "png_writer.h"
 #include "temp_folder.h"
 
+#include <pcl/common/io.h>
+#include <pcl/conversions.h>
 #include <pcl/point_types.h>
 
 #include <gtest/gtest.h>
@@ -947,4 +949,38 @@ TEST_F(DatasetFolder, DepthFramesAreReducedAsTheyAreReadTheSameOnAnyNumberOfThre
   omp_set_num_threads(omp_get_num_procs());
   EXPECT_EQ(coordinates[0], coordinates[1]);
   EXPECT_EQ(calls, 6u);
+}
+
+TEST(FrameReduction, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
+  for (float spread : {2.0f, 0.0f}) {  // 0: also two clusters 4 km apart, filtered in parts
+    pcl::PointCloud<pcl::PointXYZI> cloud;
+    for (const auto& p : scattered(30000, spread > 0 ? spread : 0.05f, 5)) cloud.push_back({p.x, p.y, p.z, 0.5f});
+    if (spread == 0.0f)
+      for (const auto& p : scattered(3000, 0.05f, 6)) cloud.push_back({p.x + 4000.0f, p.y, p.z, 0.25f});
+    cloud.push_back({std::nanf(""), 0.0f, 0.0f, 1.0f});
+    pcl::PCLPointCloud2 message;
+    pcl::toPCLPointCloud2(cloud, message);
+    const double leaf = spread > 0 ? 0.1 : 0.001;
+    const FrameReduction reduction{leaf, kDenseFramePoints, {}};
+    ASSERT_TRUE(reduceFrame(message, reduction));
+    pcl::PointCloud<pcl::PointXYZI> from_message;
+    pcl::fromPCLPointCloud2(message, from_message);
+    ASSERT_TRUE(reduceFrame(cloud, cloud.size(), reduction));
+    pcl::PointCloud<pcl::PointXYZ> a, b;
+    pcl::copyPointCloud(from_message, a);
+    pcl::copyPointCloud(cloud, b);
+    EXPECT_EQ(message.width * message.height, cloud.size());
+    EXPECT_EQ(voxelKeys(a, leaf), voxelKeys(b, leaf));
+    bool intensity = false;
+    for (const auto& field : message.fields) intensity = intensity || field.name == "intensity";
+    EXPECT_TRUE(intensity);
+    for (const auto& p : from_message) EXPECT_TRUE(p.intensity == 0.5f || p.intensity == 0.25f);
+  }
+  // A light message, or one without float coordinates, is left as it is.
+  pcl::PCLPointCloud2 light;
+  pcl::toPCLPointCloud2(scattered(100, 1.0f, 7), light);
+  EXPECT_FALSE(reduceFrame(light, FrameReduction::denseDefault()));
+  pcl::PCLPointCloud2 no_z = light;
+  no_z.fields.pop_back();
+  EXPECT_FALSE(reduceFrame(no_z, FrameReduction{0.1, 0, {}}));
 }

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
@@ -243,6 +244,43 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   addRunOptions(command, args);
 }
 
+/// "DIST,ANGLE": two finite numbers >= 0, metres and degrees.
+std::optional<obsgroup::KeyframeOptions> parseKeyframes(const std::string& text) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos) return std::nullopt;
+  obsgroup::KeyframeOptions options;
+  try {
+    std::size_t used = 0;
+    options.distance = std::stod(text.substr(0, comma), &used);
+    if (used != comma) return std::nullopt;
+    const std::string angle = text.substr(comma + 1);
+    options.angle_deg = std::stod(angle, &used);
+    if (used != angle.size()) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (!(std::isfinite(options.distance) && options.distance >= 0 && std::isfinite(options.angle_deg) &&
+        options.angle_deg >= 0))
+    return std::nullopt;
+  return options;
+}
+
+/// --keyframes, of `partition` only: the online grouping takes every frame.
+void addKeyframeOption(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  command
+      .add_option_function<std::string>(
+          "--keyframes", [&args](const std::string& text) { args.keyframes = parseKeyframes(text); },
+          "group only the frames that moved DIST metres or turned ANGLE degrees since the last keyframe; each "
+          "other frame takes its keyframe's place (default: every frame)")
+      ->type_name("DIST,ANGLE")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return parseKeyframes(text) ? std::string() : "expected DIST,ANGLE: two finite numbers >= 0 (metres, degrees)";
+          },
+          "DIST,ANGLE"))
+      ->group("Method");
+}
+
 /// `locate PLACES INPUT -o FILE.json`: the places of a run, an input read as
 /// partition reads it, and where the locations go.
 void addLocateOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, obsgroup::cli::LocateOptions& locate) {
@@ -436,6 +474,7 @@ int main(int argc, char** argv) {
   obsgroup::cli::PartitionArgs args;
   CLI::App* partition = app.add_subcommand("partition", "group the observations of a laser log, a PCD sequence, depth images or KITTI scans");
   addPartitionOptions(*partition, args);
+  addKeyframeOption(*partition, args);
   // stream binds the same options (only the command given parses any).
   obsgroup::cli::StreamOptions stream_options;
   CLI::App* stream = app.add_subcommand(

@@ -21,6 +21,7 @@
 #include <obsgroup/observation_grouping.h>
 #include <obsgroup/io/pose_file.h>
 #include <obsgroup/places/localize.h>
+#include <obsgroup/partition/keyframes.h>
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
@@ -336,7 +337,7 @@ void writePlaces(const io::OutputFolder& out, const PlaceMap& places, Warnings& 
 template <typename PointT>
 OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
                          const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps,
-                         Warnings& warn) {
+                         const Partition& of_every_frame, Warnings& warn) {
   const auto start = Clock::now();
   OutputTimes t;
   t.map_points = io::writeLocalMaps(out, maps.maps, args.method.threads);
@@ -357,7 +358,13 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
     // The groups and local maps stand without them.
     warn(std::string("places not written: ") + e.what());
   }
-  if (places) writePlaces(out, *places, warn);
+  if (places) {
+    PlaceMap written = *places;  // with keyframes, each place's members are all the frames of its keyframes
+    for (Place& place : written.places)
+      for (std::size_t g = 0; g < grouped.place_ids.size(); ++g)
+        if (grouped.place_ids[g] == place.id) place.members = of_every_frame.groups[g];
+    writePlaces(out, written, warn);
+  }
   t.places_s = secondsSince(places_start);
   if (args.pictures) {
     const auto pictures_start = Clock::now();
@@ -411,11 +418,13 @@ void printWritten(const PartitionArgs& args) {
 void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
   const auto& s = run.statistics;
   const auto& t = run.timing_s;
+  std::string counted = plural(observations, "observation");
+  if (s.contains("keyframes")) counted += ", " + plural(s.at("keyframes").get<std::size_t>(), "keyframe") + " grouped";
   std::fprintf(stderr,
                "obsgroup: %s (%s), %s evaluated, %zu overlapping, %s\n"
                "  load %.2f s, overlap %.2f s, graph %.2f s, partition %.2f s, local maps %.2f s, outputs %.2f s"
                " (pictures %.2f s)\n",
-               plural(observations, "observation").c_str(), plural(s.at("points").get<std::size_t>(), "point").c_str(),
+               counted.c_str(), plural(s.at("points").get<std::size_t>(), "point").c_str(),
                plural(s.at("pairs_evaluated").get<std::size_t>(), "pair").c_str(), s.at("edges").get<std::size_t>(),
                plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(), t.at("overlap").get<double>(),
                t.at("graph").get<double>(), t.at("partition").get<double>(), t.at("local_maps").get<double>(),
@@ -563,12 +572,36 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
   return 0;
 }
 
+/// With --keyframes: keeps the keyframes of `observations` and of what the
+/// input says of each; returns each frame's keyframe (empty without).
+template <typename PointT>
+std::vector<int> keepKeyframes(const PartitionArgs& args, std::vector<Observation<PointT>>& observations,
+                               InputRecord& input) {
+  if (!args.keyframes) return {};
+  std::vector<int> keyframe_of = selectKeyframes(posesOf(observations), *args.keyframes);
+  std::vector<Observation<PointT>> kept;
+  std::vector<std::string> labels;
+  std::vector<double> stamps;
+  for (int k : keyframesOf(keyframe_of)) {
+    kept.push_back(std::move(observations[std::size_t(k)]));
+    labels.push_back(input.labels[std::size_t(k)]);
+    if (!input.stamps.empty()) stamps.push_back(input.stamps[std::size_t(k)]);
+  }
+  observations = std::move(kept);
+  input.labels = std::move(labels);
+  input.stamps = std::move(stamps);
+  return keyframe_of;
+}
+
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
   if (args.locate) return locateObservations(args, observations, input);
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
   throwIfInterrupted(args.interrupt);
+  const std::vector<std::string> sources = input.labels;
+  const std::vector<double> stamps = input.stamps;
+  const std::vector<int> keyframe_of = keepKeyframes(args, observations, input);
   GroupingOutcome<PointT> grouped;
   configureGrouping(args, grouped.grouping);
   if (args.stream)
@@ -578,11 +611,20 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   warnAboutGrouping(observations, input, grouped, warn);
   const MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.W, warn);
   io::OutputFolder out(args.output, args.force, args.interrupt);
-  const OutputTimes written = writeResults(args, out, grouped, observations, maps, warn);
-  const io::RunRecord run = runRecord(args, input, grouped, maps, written, warn);
-  out.writeText("partition.json", io::partitionJson(grouped.partition, run));
+  const Partition of_every_frame =
+      keyframe_of.empty() ? grouped.partition : expandKeyframePartition(grouped.partition, keyframe_of);
+  const OutputTimes written = writeResults(args, out, grouped, observations, maps, of_every_frame, warn);
+  io::RunRecord run = runRecord(args, input, grouped, maps, written, warn);
+  run.sources = sources;
+  run.stamps = stamps;
+  run.keyframe_of = keyframe_of;
+  if (args.keyframes) {
+    run.parameters["keyframes"] = {{"distance", args.keyframes->distance}, {"angle_deg", args.keyframes->angle_deg}};
+    run.statistics["keyframes"] = observations.size();
+  }
+  out.writeText("partition.json", io::partitionJson(of_every_frame, run));
   out.commit();
-  if (!args.quiet) (args.stream ? printStreamSummary : printSummary)(args, run, observations.size());
+  if (!args.quiet) (args.stream ? printStreamSummary : printSummary)(args, run, of_every_frame.group_of.size());
   return 0;
 }
 

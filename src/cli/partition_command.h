@@ -8,6 +8,7 @@
 #include <obsgroup/io/pose_file.h>
 
 #include <obsgroup/grouping_parameters.h>
+#include <obsgroup/partition/keyframes.h>
 #include <obsgroup/maps/local_map_builder.h>
 
 #include <optional>
@@ -69,6 +70,9 @@ struct PartitionArgs {
   /// none: dense frames at io::kDefaultFrameVoxel as they are read.
   std::optional<double> voxel;
   std::optional<double> map_voxel;  ///< local-map voxel leaf; default delta / 2
+  /// --keyframes DIST,ANGLE: only frames that moved this far or turned this
+  /// much since the last keyframe are grouped; the others join their keyframe.
+  std::optional<KeyframeOptions> keyframes;
   Refinement refine = Refinement::None;
   bool paper = false;         ///< --paper: the preset, applied by the command line
   std::vector<double> band;  ///< --band LOW HIGH as given (then in `method.regions`)

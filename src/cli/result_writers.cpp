@@ -82,6 +82,8 @@ std::string partitionJson(const Partition& partition, const RunRecord& run) {
       << "  \"place_ids\": " << nlohmann::json(run.place_ids).dump() << ",\n"
       << "  \"sources\": " << nlohmann::json(run.sources).dump() << ",\n"
       << "  \"stamps\": " << (run.stamps.empty() ? nlohmann::json() : nlohmann::json(run.stamps)).dump() << ",\n"
+      << "  \"keyframe_of\": "
+      << (run.keyframe_of.empty() ? nlohmann::json() : nlohmann::json(run.keyframe_of)).dump() << ",\n"
       << "  \"splits\": " << arrayPerLine(partition.splits.size(), split) << ",\n"
       << "  \"parameters\": " << run.parameters.dump() << ",\n"
       << "  \"statistics\": " << run.statistics.dump() << ",\n"

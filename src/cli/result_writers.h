@@ -27,10 +27,13 @@ struct RunRecord {
   /// no stamps), in observation order.
   std::vector<std::string> sources;
   std::vector<double> stamps;
+  /// With keyframes: each observation's keyframe (its own index for a
+  /// keyframe); empty: every observation was grouped.
+  std::vector<int> keyframe_of;
 };
 
 /// {"observations": N, "groups": [[...]], "place_ids": [...], "sources": [...],
-///  "stamps": [...] or null, "splits": [...], "parameters": {...},
+///  "stamps": [...] or null, "keyframe_of": [...] or null, "splits": [...], "parameters": {...},
 ///  "statistics": {...}, "warnings": [...], "input": "...", "timing_s": {...}}, keys in this order,
 /// one group and one split per line.
 std::string partitionJson(const Partition& partition, const RunRecord& run);

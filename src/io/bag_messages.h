@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 #include <pcl/PCLPointCloud2.h>
 
+#include "obsgroup/io/frame_reduction.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -54,6 +56,8 @@ struct Scan {
 struct Cloud {
   Header header;
   pcl::PCLPointCloud2 cloud;
+  std::size_t sensor_points = 0;  ///< width x height as recorded, before any reduction
+  bool reduced = false;           ///< voxel-filtered as it was decoded
 };
 
 /// One geometry_msgs/TransformStamped of a tf2_msgs/TFMessage: the pose of
@@ -88,9 +92,13 @@ struct Request {
   std::string data_topic;
   std::optional<std::string> pose_topic;
   bool tf = true;  ///< false when the poses come from elsewhere (a trajectory file): /tf is not read
+  const FrameReduction* reduction = nullptr;  ///< how each PointCloud2 is reduced as it is decoded
 };
 
 struct Messages {
+  /// Set by the caller: each PointCloud2 is reduced so as it is decoded, so
+  /// that a long recording is never held at full resolution.
+  const FrameReduction* reduce_clouds = nullptr;
   std::vector<Numbered<Scan>> scans;
   std::vector<Numbered<Cloud>> clouds;
   std::vector<Numbered<Transform>> tf;         ///< /tf, every transform of every message
@@ -150,5 +158,12 @@ Messages readRos1Messages(const std::string& path, const Request& request);
 /// that storage is not supported.
 std::vector<Topic> listRos2Topics(const std::string& folder);
 Messages readRos2Messages(const std::string& folder, const Request& request);
+
+/// Records the cloud's sensor points and reduces it as `reduction` says
+/// (null: kept whole).
+inline void keepReduced(Cloud& cloud, const FrameReduction* reduction) {
+  cloud.sensor_points = std::size_t(cloud.cloud.width) * cloud.cloud.height;
+  if (reduction) cloud.reduced = reduceFrame(cloud.cloud, *reduction);
+}
 
 }  // namespace obsgroup::io::bag

@@ -490,7 +490,8 @@ void addObservations(const std::vector<Numbered<Message>>& messages, const std::
       sequence.observations.push_back({scanPoints<PointT>(message), *pose});
     } else {
       auto cloud = cloudPoints<PointT>(message, label);
-      sequence.reduced += reduceFrame(*cloud, std::size_t(message.cloud.width) * message.cloud.height, reduction);
+      // Reduced as it was decoded, or now when the reader was given no reduction then.
+      sequence.reduced += message.reduced || reduceFrame(*cloud, message.sensor_points, reduction);
       Eigen::Isometry3d body_pose = *pose;
       if (isOpticalFrame(message.header.frame_id)) {  // as depth images: into the body frame, z up
         const Eigen::Matrix3f to_body = kOpticalInBody.cast<float>();
@@ -562,7 +563,7 @@ BagReader::BagReader(const std::string& path, BagVersion version, const BagOptio
   // The topics as the bag spells them (a name given without its leading slash).
   c.options.topic = c.data.name;
   if (options.pose_topic) c.options.pose_topic = checkPoseTopic(c.topics, *options.pose_topic, path);
-  const bag::Request request{c.data.name, c.options.pose_topic, !options.poses_file};
+  const bag::Request request{c.data.name, c.options.pose_topic, !options.poses_file, &c.options.reduction};
   c.messages = ros1 ? bag::readRos1Messages(path, request) : bag::readRos2Messages(path, request);
 }
 

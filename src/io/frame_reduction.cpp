@@ -1,11 +1,13 @@
 #include "obsgroup/io/frame_reduction.h"
 
 #include <pcl/common/common.h>
+#include <pcl/common/io.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_types.h>
 
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <cstdint>
 #include <limits>
@@ -50,7 +52,97 @@ void filterInParts(const pcl::PointCloud<PointT>& points, double leaf, pcl::Poin
   filterInParts(above, leaf, out);
 }
 
+/// The byte offset of FLOAT32 field `name`, or -1.
+long floatField(const pcl::PCLPointCloud2& cloud, const char* name) {
+  for (const auto& field : cloud.fields)
+    if (field.name == name && field.datatype == pcl::PCLPointField::FLOAT32 && field.count >= 1 &&
+        std::size_t(field.offset) + sizeof(float) <= cloud.point_step)
+      return long(field.offset);
+  return -1;
+}
+
+/// filterInParts for a message's points `indices`, x, y, z at `offsets`.
+void filterInParts(const pcl::PCLPointCloud2& cloud, const pcl::Indices& indices, const long offsets[3], double leaf,
+                   pcl::PCLPointCloud2& out) {
+  if (indices.empty()) return;
+  const auto coordinate = [&](int index, int axis) {
+    float value;
+    std::memcpy(&value, &cloud.data[std::size_t(index) * cloud.point_step + std::size_t(offsets[axis])], sizeof value);
+    return value;
+  };
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+  for (int index : indices)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], coordinate(index, a));
+      hi[a] = std::max(hi[a], coordinate(index, a));
+    }
+  if (voxelCount(lo, hi, leaf) < double(std::numeric_limits<std::int32_t>::max())) {
+    pcl::PCLPointCloud2::Ptr part(new pcl::PCLPointCloud2);
+    pcl::copyPointCloud(cloud, indices, *part);
+    pcl::VoxelGrid<pcl::PCLPointCloud2> grid;
+    grid.setLeafSize(float(leaf), float(leaf), float(leaf));
+    grid.setInputCloud(part);
+    pcl::PCLPointCloud2 reduced;
+    grid.filter(reduced);
+    if (out.data.empty() && out.fields.empty()) {
+      out = std::move(reduced);
+    } else {
+      out.data.insert(out.data.end(), reduced.data.begin(), reduced.data.end());
+      out.width += reduced.width * reduced.height;
+    }
+    return;
+  }
+  Eigen::Index axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const double cut = std::floor((std::floor(double(lo[axis]) / leaf) + std::floor(double(hi[axis]) / leaf)) / 2.0);
+  pcl::Indices below, above;
+  for (int index : indices) (std::floor(double(coordinate(index, int(axis))) / leaf) <= cut ? below : above).push_back(index);
+  filterInParts(cloud, below, offsets, leaf, out);
+  filterInParts(cloud, above, offsets, leaf, out);
+}
+
 }  // namespace
+
+bool reduceFrame(pcl::PCLPointCloud2& cloud, const FrameReduction& reduction) {
+  const std::size_t count = std::size_t(cloud.width) * cloud.height;
+  if (count == 0 || !reduction.reduces(count)) return false;
+  const long offsets[3] = {floatField(cloud, "x"), floatField(cloud, "y"), floatField(cloud, "z")};
+  const std::size_t row = std::size_t(cloud.width) * cloud.point_step;
+  if (offsets[0] < 0 || offsets[1] < 0 || offsets[2] < 0 || cloud.row_step < row ||
+      cloud.data.size() < std::size_t(cloud.height - 1) * cloud.row_step + row)
+    return false;
+  if (cloud.row_step != row) {  // rows padded (a driver's alignment): packed, as the points are indexed below
+    std::vector<std::uint8_t> packed(count * cloud.point_step);
+    for (std::size_t r = 0; r < cloud.height; ++r)
+      std::memcpy(&packed[r * row], &cloud.data[r * cloud.row_step], row);
+    cloud.data.swap(packed);
+    cloud.row_step = static_cast<std::uint32_t>(row);
+  }
+  pcl::Indices finite;
+  finite.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    bool ok = true;
+    for (int a = 0; a < 3; ++a) {
+      float value;
+      std::memcpy(&value, &cloud.data[k * cloud.point_step + std::size_t(offsets[a])], sizeof value);
+      ok = ok && std::isfinite(value);
+    }
+    if (ok) finite.push_back(static_cast<int>(k));
+  }
+  pcl::PCLPointCloud2 reduced;
+  filterInParts(cloud, finite, offsets, reduction.voxel_leaf, reduced);
+  if (reduced.fields.empty()) {  // no finite point: an empty cloud of the same fields
+    reduced.fields = cloud.fields;
+    reduced.point_step = cloud.point_step;
+    reduced.is_bigendian = cloud.is_bigendian;
+  }
+  reduced.header = cloud.header;
+  reduced.height = 1;
+  reduced.row_step = reduced.width * reduced.point_step;
+  reduced.is_dense = true;
+  cloud = std::move(reduced);
+  return true;
+}
 
 void readFramesInParallel(std::size_t count, const std::function<void(std::size_t)>& read,
                           const std::function<void(std::size_t, std::size_t)>& progress) {

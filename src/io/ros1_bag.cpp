@@ -181,6 +181,7 @@ void decodeRos1Message(const std::string& type, Role role, const unsigned char* 
     checkScan(into.scans.back().message, context);
   } else if (type == kPointCloud2Type) {
     into.clouds.push_back({number, readCloud(in)});
+    keepReduced(into.clouds.back().message, into.reduce_clouds);
   } else if (type == kTfType) {
     readTransforms(in, number, role == Role::TfStatic ? into.tf_static : into.tf);
   } else {
@@ -266,6 +267,7 @@ Messages readRos1Messages(const std::string& path, const Request& request) {
     std::vector<std::string> asked;
     for (const auto& [topic, role] : roles) asked.push_back(topic);
     Messages messages;
+    messages.reduce_clouds = request.reduction;
     std::map<std::string, std::size_t> numbers;
     std::vector<std::uint8_t> bytes;
     for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(asked))) {

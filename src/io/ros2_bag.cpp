@@ -546,6 +546,7 @@ void decodeRos2Message(const std::string& type_name, Role role, const unsigned c
     into.scans.push_back({number, decodeScan(in)});
   } else if (type == kPointCloud2Type) {
     into.clouds.push_back({number, decodeCloud(in)});
+    keepReduced(into.clouds.back().message, into.reduce_clouds);
   } else if (type == kTfType) {
     decodeTf(in, number, role == Role::TfStatic ? into.tf_static : into.tf);
   } else if (type == kOdometryType) {
@@ -565,6 +566,7 @@ Messages readRos2Messages(const std::string& folder, const Request& request) {
     return *topic;
   };
   Messages messages;
+  messages.reduce_clouds = request.reduction;
   readTopic(bag, required(request.data_topic), Role::Data, messages);
   if (request.pose_topic) readTopic(bag, required(*request.pose_topic), Role::Pose, messages);
   if (!request.tf) return messages;

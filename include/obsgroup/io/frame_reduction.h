@@ -6,6 +6,7 @@
 // so a reader holds one full-resolution frame per thread and the reduced
 // ones of the others.
 
+#include <pcl/PCLPointCloud2.h>
 #include <pcl/point_cloud.h>
 
 #include <cstddef>
@@ -56,5 +57,12 @@ void readFramesInParallel(std::size_t count, const std::function<void(std::size_
 
 template <typename PointT>
 bool reduceFrame(pcl::PointCloud<PointT>& cloud, std::size_t sensor_points, const FrameReduction& reduction);
+
+/// The same for a cloud as a message carries it (a ROS PointCloud2), every
+/// field averaged per voxel as pcl::VoxelGrid<pcl::PCLPointCloud2> does, so
+/// that a bag reader keeps only the reduced message: its sensor points are
+/// width x height. Left as it is (false) when it has no FLOAT32 x, y and z
+/// fields or fewer bytes than its points need: the reader reports those.
+bool reduceFrame(pcl::PCLPointCloud2& cloud, const FrameReduction& reduction);
 
 }  // namespace obsgroup::io
