@@ -43,7 +43,7 @@ for r in (1, 2, 3):
     wall, kib = open(f"{work}/refine_{refine}.{r}.time").read().split()[-2:]
     maps.append(p["timing_s"]["local_maps"]); walls.append(float(wall)); rss.append(int(kib) / 1024)
 s = p["statistics"]
-print(f"| {refine} | {n:,} | {s['groups']:,} | {s.get('refined_members', 0):,} | {statistics.median(maps):.2f} | "
+print(f"| {refine} | {n:,} | {s['groups']:,} | {s.get('refinement', {}).get('moved', 0):,} | {statistics.median(maps):.2f} | "
       f"{statistics.median(walls):.2f} | {max(rss):,.0f} |")
 PY
 done

@@ -23,6 +23,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <cctype>
 #include <sstream>
 #include <cerrno>
 #include <chrono>
@@ -703,8 +704,18 @@ TEST_F(Cli, UsageMessagesSayWhatIsWrong) {
   for (const char* choices : {"none|icp|lum", "points|free-space|visibility", "mean|sign|best", "tum|kitti"})
     EXPECT_NE(help.out.find(choices), std::string::npos) << choices;
   for (const char* noise : {"ENUM", "{false}", "->", "1797"}) EXPECT_EQ(help.out.find(noise), std::string::npos) << noise;
-  EXPECT_NE(help.out.find("(default: visibility)"), std::string::npos);
-  EXPECT_NE(help.out.find("(default: none)"), std::string::npos);
+  // Descriptions are wrapped to 100 columns: read them as flowing text.
+  std::string flat;
+  for (char c : help.out)
+    if (!std::isspace(static_cast<unsigned char>(c)) || (!flat.empty() && flat.back() != ' ')) flat += std::isspace(static_cast<unsigned char>(c)) ? ' ' : c;
+  EXPECT_NE(flat.find("(default: visibility)"), std::string::npos);
+  EXPECT_NE(flat.find("(default: none)"), std::string::npos);
+  std::istringstream lines(help.out);
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 100u) << line;
+  for (const char* group : {"Sensed-space model:", "Partition:", "Local maps:", "Output:", "CARMEN logs:",
+                            "Poses (PCD sequences, depth images, KITTI, bags):", "Depth images:", "ROS bags:"})
+    EXPECT_NE(help.out.find(group), std::string::npos) << group;
+  EXPECT_NE(flat.find("ROS bag"), std::string::npos);  // the description names every input kind
 }
 
 // partition.json's timing says how many threads ran, and one group is "1 group".

@@ -186,7 +186,7 @@ TEST(Refinement, ACorridorDoesNotSayWhereAlongItAScanWas) {
     const Eigen::Isometry3d expected = truth[map.frame.reference].inverse() * truth[2];
     EXPECT_NEAR(result.translation().y(), expected.translation().y(), 0.01) << toString(r);
     EXPECT_GT(map.refinement.pairs_partial, 0) << toString(r);
-    EXPECT_NE(map.refinement.warning().find("corridor"), std::string::npos) << map.refinement.warning();
+    EXPECT_EQ(map.refinement.warning(), "") << "a corridor's free length is expected, not a warning";
   }
 }
 
@@ -259,8 +259,7 @@ TEST(Refinement, MembersNoAlignmentJoinsToTheReferenceAreNamed) {
     ASSERT_EQ(map.frame.reference, 0) << toString(r);
     EXPECT_EQ(map.refinement.unlinked, (std::vector<int>{2, 3})) << toString(r);
     EXPECT_EQ(map.refinement.kept_unaligned, 0) << toString(r);
-    EXPECT_NE(map.refinement.warning().find("no alignment joins to their map's reference"), std::string::npos)
-        << map.refinement.warning();
+    EXPECT_EQ(map.refinement.warning(), "2 of 3 members not linked to their map's reference");
   }
 }
 

@@ -43,6 +43,58 @@ void catchInterrupts() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
+/// CLI11's help with every description wrapped to fit kHelpWidth columns
+/// (CLI11 2.1 writes each on one line, however long).
+class WrappingFormatter : public CLI::Formatter {
+ public:
+  static constexpr std::size_t kHelpWidth = 100;
+
+  std::string make_option(const CLI::Option* option, bool is_positional) const override {
+    return layOut("  " + make_option_name(option, is_positional) + make_option_opts(option),
+                  make_option_desc(option));
+  }
+  std::string make_description(const CLI::App* app) const override {
+    const std::string description = CLI::Formatter::make_description(app);
+    std::string out;
+    for (const std::string& line : wrap(description, kHelpWidth)) out += line + "\n";
+    return out.empty() ? out : out.substr(0, out.size() - 1) + (description.back() == '\n' ? "\n" : "");
+  }
+
+ private:
+  /// `name` in the first column, `text` wrapped beside it (below it when the
+  /// name is wider than the column).
+  std::string layOut(const std::string& name, const std::string& text) const {
+    const std::size_t column = get_column_width();
+    std::string out = name;
+    const std::vector<std::string> lines = wrap(text, kHelpWidth - column);
+    if (lines.empty()) return out + "\n";
+    if (name.size() >= column) out += "\n" + std::string(column, ' ');
+    else out += std::string(column - name.size(), ' ');
+    for (std::size_t k = 0; k < lines.size(); ++k) out += (k ? std::string(column, ' ') : "") + lines[k] + "\n";
+    return out;
+  }
+
+  /// `text` as lines of at most `width` characters, broken at spaces (a
+  /// longer word stands alone); its own line breaks are kept.
+  static std::vector<std::string> wrap(const std::string& text, std::size_t width) {
+    std::vector<std::string> lines;
+    std::istringstream paragraphs(text);
+    for (std::string paragraph; std::getline(paragraphs, paragraph);) {
+      std::istringstream words(paragraph);
+      std::string line;
+      for (std::string word; words >> word;) {
+        if (!line.empty() && line.size() + 1 + word.size() > width) {
+          lines.push_back(line);
+          line.clear();
+        }
+        line += (line.empty() ? "" : " ") + word;
+      }
+      if (!line.empty()) lines.push_back(line);
+    }
+    return lines;
+  }
+};
+
 using namespace obsgroup;
 using cli::choices;
 using cli::finiteNumber;
@@ -104,17 +156,17 @@ void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                      "PCD: poses file, one line per cloud, or matched by timestamp when the files are named by one "
                      "(default: each PCD's VIEWPOINT); depth images, KITTI: instead of the folder's; bags: a TUM "
                      "trajectory of the sensor matched by timestamp, instead of /tf")
-      ->group("PCD sequences");
+      ->group("Poses (PCD sequences, depth images, KITTI, bags)");
   command.add_option("--pose-format", args.pose_format, "PCD: format of --poses (default: from the column count, 8 "
                                                         "tum, 12 kitti)")
       ->transform(oneOf(io::kPoseFormatNames))
       ->option_text(choices(io::kPoseFormatNames))
-      ->group("PCD sequences");
+      ->group("Poses (PCD sequences, depth images, KITTI, bags)");
   command.add_option("--max-time-difference", args.max_time_difference,
                      "TUM poses matched by timestamp (depth images, PCD, bags): most seconds between a frame and its pose (default: " +
                          (std::ostringstream() << io::kDefaultMaxTimeDifference).str() + ")")
       ->check(finiteNumber(0.0))
-      ->group("PCD sequences");
+      ->group("Poses (PCD sequences, depth images, KITTI, bags)");
 }
 
 /// Options of depth image sequences.
@@ -148,71 +200,71 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                      "visibility (cells visible from the pose) (default: " + toString(args.method.model) + ")")
       ->transform(oneOf(kSensedSpaceModelNames))
       ->option_text(choices(kSensedSpaceModelNames))
-      ->group("Method");
+      ->group("Sensed-space model");
   const obsgroup::GroupingParameters paper = obsgroup::GroupingParameters::paper();
   command.add_flag("--paper", args.paper,
                    "the paper's method exactly: --sso " + toString(paper.model) + " --split " + toString(paper.split) +
                        " --ncut-threshold " + number(paper.ncut_threshold) + " --boundary-passes " +
                        std::to_string(paper.boundary_passes) + " (delta as given)")
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--cell", args.method.regions.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--range", args.method.regions.max_range, "free-space, visibility: how far from the sensor, metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--clearance", args.method.regions.clearance,
                      "visibility: occupied cells nearer the pose than this do not block, metres")
       ->check(finiteNumber(0.0))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--min-observations", args.method.regions.min_observations,
                      "visibility: a cell is occupied when this many observations have a point in it (and no more "
                      "saw through it)")
       ->check(wholeNumber(1))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--band", args.band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
                                           "LOW HIGH metres (default: " + std::to_string(args.method.regions.band_low) + " " +
                                           std::to_string(args.method.regions.band_high) + ")")
       ->expected(2)
       ->check(finiteNumber(-std::numeric_limits<double>::max()))
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--delta", args.method.match_distance, "points: match distance of eq. (16), metres")
       ->check(finiteNumber(0.0, true))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--voxel", args.voxel,
                      "voxel leaf of every observation, metres, applied as each frame is read (0 = keep every point; "
                      "default: dense frames of " + std::to_string(obsgroup::io::kDenseFramePoints) + "+ points at " +
                          number(obsgroup::io::kDefaultFrameVoxel) + ", others whole)")
       ->check(finiteNumber(0.0))
-      ->group("Method");
+      ->group("Sensed-space model");
   command.add_option("--ncut-threshold", args.method.ncut_threshold, "accept a bisection while Ncut < this (sec. II-B)")
       ->check(finiteNumber(0.0, false, 2.0))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Partition");
   command.add_option("--boundary-passes", args.method.boundary_passes,
                      "sweeps after the split tree moving each observation to the group it overlaps most on "
                      "average (0: none, the paper's)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Partition");
   command.add_option("--split", args.method.split,
                      "how the eigenvector is cut: best (smallest Ncut), mean (the paper's) or sign (default: " +
                          toString(args.method.split) + ")")
       ->transform(oneOf(kSplitCriterionNames))
       ->option_text(choices(kSplitCriterionNames))
-      ->group("Method");
+      ->group("Partition");
   command.add_option("--min-group-size", args.method.min_group_size, "reject a bisection giving a smaller group")
       ->check(wholeNumber(1))
       ->capture_default_str()
-      ->group("Method");
+      ->group("Partition");
   command.add_option("--max-depth", args.method.max_depth, "do not bisect deeper than this (default: no limit)")
       ->check(wholeNumber(0))
-      ->group("Method");
+      ->group("Partition");
 }
 
 /// Threads, refinement, local maps and the outputs.
@@ -224,14 +276,17 @@ void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                      "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios) (default: " +
                          toString(args.refine) + ")")
       ->transform(oneOf(kRefinementNames))
-      ->option_text(choices(kRefinementNames));
+      ->option_text(choices(kRefinementNames))
+      ->group("Local maps");
   command.add_option("--map-voxel", args.map_voxel,
                      "voxel leaf of the local maps written, metres (0 = off; default: delta/2)")
-      ->check(finiteNumber(0.0));
-  command.add_flag("--force", args.force, "replace the results already in the output folder");
-  command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr");
+      ->check(finiteNumber(0.0))
+      ->group("Local maps");
+  command.add_flag("--force", args.force, "replace the results already in the output folder")->group("Output");
+  command.add_flag("-q,--quiet", args.quiet, "no progress bar, summary or warnings on stderr")->group("Output");
   command.add_flag("--no-pictures", args.no_pictures,
-                   "do not draw map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png");
+                   "do not draw map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png")
+      ->group("Output");
 }
 
 void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
@@ -278,7 +333,7 @@ void addKeyframeOption(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
             return parseKeyframes(text) ? std::string() : "expected DIST,ANGLE: two finite numbers >= 0 (metres, degrees)";
           },
           "DIST,ANGLE"))
-      ->group("Method");
+      ->group("Partition");
 }
 
 /// `locate PLACES INPUT -o FILE.json`: the places of a run, an input read as
@@ -468,11 +523,14 @@ int main(int argc, char** argv) {
 
   CLI::App app{"obsgroup: group robot observations into consistent local maps and a metric-topological map",
                "obsgroup"};
+  app.formatter(std::make_shared<WrappingFormatter>());  // before the subcommands, which copy it
   app.set_version_flag("--version", "obsgroup 0.1.0");
   app.require_subcommand(1, 1);
   app.failure_message(failureMessage);
   obsgroup::cli::PartitionArgs args;
-  CLI::App* partition = app.add_subcommand("partition", "group the observations of a laser log, a PCD sequence, depth images or KITTI scans");
+  CLI::App* partition = app.add_subcommand(
+      "partition", "group the observations of a laser log, a PCD sequence, depth images, KITTI scans or a ROS bag "
+                   "into places: local maps, a topological map, place outlines and pictures");
   addPartitionOptions(*partition, args);
   addKeyframeOption(*partition, args);
   // stream binds the same options (only the command given parses any).

@@ -188,7 +188,9 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
   out.W = grouping.getWeightMatrix();
   const auto& overlap = grouping.getOverlap();
   out.points_per_observation = overlap.points_per_observation;
-  out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated},
+  // The back-ends count ordered pairs (i, j) and (j, i) alike (each row is
+  // matched on its own); a user counts a pair once.
+  out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated / 2},
                     {"point_tests", overlap.point_tests},
                     {"edges", overlap.pairs.size()}};
   const auto& t = grouping.getTimings();
@@ -237,7 +239,8 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
            " m voxel filter; written unfiltered");
     run.refinement += run.maps[g].refinement;
   }
-  if (!run.refinement.warning().empty()) warn("refinement: " + run.refinement.warning());
+  if (!run.refinement.warning().empty())
+    warn("refinement: " + run.refinement.warning() + " (see partition.json: statistics.refinement)");
   run.topology = buildTopologicalMap(std::move(frames), W, posesOf(observations), args.method.threads);
   run.seconds = secondsSince(start);
   return run;
@@ -391,9 +394,19 @@ io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, con
   run.statistics = grouped.statistics;
   run.statistics.update({{"points", points},
                          {"groups", grouped.partition.groups.size()},
-                         {"local_map_points", written.map_points},
-                         {"refined_members", maps.refinement.moved},
-                         {"kept_members", maps.refinement.members - maps.refinement.moved}});
+                         {"local_map_points", written.map_points}});
+  if (args.refine != Refinement::None) {
+    const RefinementReport& r = maps.refinement;
+    run.statistics["refinement"] = {{"members", r.members},
+                                    {"moved", r.moved},
+                                    {"kept_not_better", r.kept_not_better},
+                                    {"kept_beyond_bound", r.kept_beyond_bound},
+                                    {"kept_unaligned", r.kept_unaligned},
+                                    {"pairs", r.pairs},
+                                    {"pairs_refused", r.pairs_refused},
+                                    {"pairs_partial", r.pairs_partial},
+                                    {"unlinked", r.unlinked}};
+  }
   run.warnings = warn.all();
   run.place_ids = grouped.place_ids;
   run.sources = input.labels;
@@ -621,6 +634,10 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   if (args.keyframes) {
     run.parameters["keyframes"] = {{"distance", args.keyframes->distance}, {"angle_deg", args.keyframes->angle_deg}};
     run.statistics["keyframes"] = observations.size();
+    if (run.statistics.contains("refinement")) {  // the maps' observations are the keyframes: name the frames
+      const std::vector<int> keyframes = keyframesOf(keyframe_of);
+      for (auto& k : run.statistics["refinement"]["unlinked"]) k = keyframes.at(k.get<std::size_t>());
+    }
   }
   out.writeText("partition.json", io::partitionJson(of_every_frame, run));
   out.commit();

@@ -5,6 +5,7 @@
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -150,6 +151,7 @@ void readFramesInParallel(std::size_t count, const std::function<void(std::size_
   std::vector<std::exception_ptr> errors(count);
   std::atomic<std::int64_t> first_failed{n};
   std::atomic<std::size_t> done{0};
+  std::size_t reported = 0;  // the most frames reported: counts reach the critical section out of order
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t k = 0; k < n; ++k) {
     if (k > first_failed.load()) continue;
@@ -163,7 +165,10 @@ void readFramesInParallel(std::size_t count, const std::function<void(std::size_
     const std::size_t frames = ++done;
     if (progress) {
 #pragma omp critical(obsgroup_frame_progress)
-      progress(frames, count);
+      {
+        reported = std::max(reported, frames);
+        progress(reported, count);
+      }
     }
   }
   for (const auto& error : errors)

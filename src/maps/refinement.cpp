@@ -18,24 +18,15 @@
 namespace obsgroup {
 
 std::string RefinementReport::warning() const {
-  if (kept_beyond_bound == 0 && kept_unaligned == 0 && pairs_partial == 0 &&
-      static_cast<int>(unlinked.size()) <= kept_unaligned)
-    return "";
-  std::string text = "refined " + std::to_string(moved) + " of " + std::to_string(members) + " members";
-  if (kept_beyond_bound > 0)
-    text += "; " + std::to_string(kept_beyond_bound) + " kept their input pose (the correction exceeded its bound)";
-  if (kept_unaligned > 0)
-    text += "; " + std::to_string(kept_unaligned) + " kept their input pose (no pair aligned: " +
-            std::to_string(pairs_refused) + " of " + std::to_string(pairs) + " pairs refused)";
-  if (pairs_partial > 0)
-    text += "; " + std::to_string(pairs_partial) + " of " + std::to_string(pairs) +
-            " pairs constrain only some directions (a corridor): the others keep the input poses";
-  // The unaligned members are unlinked too, and already said.
+  // The unaligned members are unlinked too: counted once, as kept.
+  const int kept = kept_beyond_bound + kept_unaligned;
   const int apart = static_cast<int>(unlinked.size()) - kept_unaligned;
+  if (kept <= 0 && apart <= 0) return "";  // pairs that leave a corridor's length free are expected
+  std::string text;
+  if (kept > 0) text = std::to_string(kept) + " of " + std::to_string(members) + " members kept the input pose";
   if (apart > 0)
-    text += "; " + std::to_string(apart) +
-            " aligned only with members that no alignment joins to their map's reference (no surface in common "
-            "with it): their place relative to it is the input's";
+    text += (text.empty() ? "" : "; ") + std::to_string(apart) + (text.empty() ? " of " + std::to_string(members) + " members" : "") +
+            " not linked to their map's reference";
   return text;
 }
 

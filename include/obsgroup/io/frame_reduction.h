@@ -30,8 +30,8 @@ struct FrameReduction {
   double voxel_leaf = 0.0;
   /// Frames whose sensor gives fewer points than this are kept whole.
   std::size_t min_points = 0;
-  /// Called with the frames read so far and their total, from one thread at
-  /// a time; may be empty.
+  /// Called with the frames read so far (never fewer than the call before)
+  /// and their total, from one thread at a time; may be empty.
   std::function<void(std::size_t, std::size_t)> progress;
 
   /// The settings the command uses when no leaf is given: dense frames at

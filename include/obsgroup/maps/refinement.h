@@ -97,8 +97,10 @@ struct RefinementReport {
   /// view (a depth camera) shares no surface with the views after a turn.
   std::vector<int> unlinked;
 
-  /// One line for the run's warnings, or "" when nothing deserves one
-  /// (members kept because their input pose was already as good are normal).
+  /// One short line for the run's warnings ("3 of 40 members kept the input
+  /// pose; 2 not linked to their map's reference"), or "" when nothing
+  /// deserves one: members kept because their input pose was already as
+  /// good, and pairs that leave a corridor's length to the input, are normal.
   std::string warning() const;
   /// Adds another map's counts: one report, and one warning, for a whole run.
   RefinementReport& operator+=(const RefinementReport& other);
