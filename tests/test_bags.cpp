@@ -346,7 +346,7 @@ TEST_F(Ros1Bag, DenseCloudsAreReducedAsTheyAreDecoded) {
   EXPECT_EQ(whole.observations[0].cloud->size(), 24000u);
   EXPECT_EQ(whole.reduced, 0u);
   BagOptions options;
-  options.reduction = FrameReduction::denseDefault();
+  options.reduction = FrameReading::denseDefault();
   const BagSequence reduced = loadBag(path(), BagVersion::Ros1, options);
   EXPECT_EQ(reduced.reduced, 2u);
   ASSERT_EQ(reduced.observations.size(), 2u);

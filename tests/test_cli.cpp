@@ -1310,6 +1310,30 @@ TEST_F(Cli, BagOptionsAndBadBags) {
 // ---------------------------------------------------------------------------
 // Depth image sequences, KITTI odometry and TUM poses matched by timestamp.
 
+TEST_F(Cli, AFolderWithABrokenFileIsSalvagedOnlyWhenAsked) {
+  const fs::path folder = dir_ / "pcd";
+  fs::create_directories(folder);
+  for (const auto& entry : fs::directory_iterator(kData + "/office_3d/pcd"))
+    fs::copy_file(entry.path(), folder / entry.path().filename());
+  std::ofstream(folder / "000005.pcd", std::ios::trunc) << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\n";  // cut short
+  const std::string poses = " --poses " + kData + "/office_3d/poses.txt";
+  const Result failed = run("partition " + folder.string() + poses + " -q --no-pictures -o " + (dir_ / "a").string());
+  EXPECT_EQ(failed.code, 3);
+  EXPECT_NE(failed.err.find("000005.pcd"), std::string::npos) << failed.err;
+  // Each file keeps its own pose: the poses file has one per file, the broken one's dropped with it.
+  const Result salvaged = run("partition " + folder.string() + poses + " --no-pictures --skip-bad-files -o " +
+                              (dir_ / "b").string());
+  ASSERT_EQ(salvaged.code, 0) << salvaged.err;
+  EXPECT_NE(salvaged.err.find("--skip-bad-files: left out 1 of 40 files that could not be read: "), std::string::npos)
+      << salvaged.err;
+  EXPECT_NE(salvaged.err.find("000005.pcd"), std::string::npos) << salvaged.err;
+  const nlohmann::json p = expectPartitionSchema(dir_ / "b", 39);
+  for (const auto& source : p.at("sources")) EXPECT_EQ(source.get<std::string>().find("000005.pcd"), std::string::npos);
+  const Result wrong_kind = run("partition " + kData + "/office_2d/office.clf --skip-bad-files -o " + (dir_ / "c").string());
+  EXPECT_EQ(wrong_kind.code, 2);
+  EXPECT_NE(wrong_kind.err.find("--skip-bad-files applies to folders of files"), std::string::npos) << wrong_kind.err;
+}
+
 TEST_F(Cli, KeyframesAreGroupedAndEveryOtherFrameTakesItsKeyframesPlace) {
   const std::string input = kData + "/office_3d/pcd";
   const Result r = run("partition " + input + " -q --no-pictures --keyframes 3,60 -o " + (dir_ / "k").string());

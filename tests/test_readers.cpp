@@ -3,7 +3,7 @@
 #include <obsgroup/io/carmen_reader.h>
 #include <obsgroup/io/depth_sequence.h>
 #include <obsgroup/io/errors.h>
-#include <obsgroup/io/frame_reduction.h>
+#include <obsgroup/io/frame_reading.h>
 #include <obsgroup/io/kitti_sequence.h>
 #include <obsgroup/io/pcd_sequence.h>
 #include <obsgroup/io/pose_file.h>
@@ -847,11 +847,11 @@ pcl::PointCloud<pcl::PointXYZ> scattered(std::size_t count, float spread, unsign
 
 }  // namespace
 
-TEST(FrameReduction, EachOccupiedVoxelBecomesOnePointAndAgainChangesNothing) {
+TEST(FrameReading, EachOccupiedVoxelBecomesOnePointAndAgainChangesNothing) {
   pcl::PointCloud<pcl::PointXYZ> cloud = scattered(20000, 2.0f, 1);
   cloud.push_back({std::nanf(""), 0.0f, 0.0f});
   const auto keys = voxelKeys(scattered(20000, 2.0f, 1), 0.1);
-  const FrameReduction reduction{0.1, 0, {}};
+  const FrameReading reduction{0.1, 0, {}};
   ASSERT_TRUE(reduceFrame(cloud, cloud.size(), reduction));
   EXPECT_EQ(cloud.size(), keys.size());           // one point per occupied voxel, the NaN gone
   EXPECT_EQ(voxelKeys(cloud, 0.1), keys);          // each inside its own voxel
@@ -861,52 +861,70 @@ TEST(FrameReduction, EachOccupiedVoxelBecomesOnePointAndAgainChangesNothing) {
   ASSERT_EQ(cloud.size(), once.size());  // so the grouping's own filter at the same leaf is a no-op
 }
 
-TEST(FrameReduction, OnlyDenseFramesAreReducedByDefault) {
-  const FrameReduction reduction = FrameReduction::denseDefault();
+TEST(FrameReading, OnlyDenseFramesAreReducedByDefault) {
+  const FrameReading reduction = FrameReading::denseDefault();
   pcl::PointCloud<pcl::PointXYZ> cloud = scattered(5000, 2.0f, 2);
   EXPECT_FALSE(reduceFrame(cloud, kDenseFramePoints - 1, reduction));  // a light sensor: every point kept
   EXPECT_EQ(cloud.size(), 5000u);
   EXPECT_TRUE(reduceFrame(cloud, kDenseFramePoints, reduction));  // a dense one, whatever is left of it
   EXPECT_LT(cloud.size(), 5000u);
-  EXPECT_FALSE(reduceFrame(cloud, 1000000, FrameReduction{0.0, 0, {}}));  // --voxel 0 keeps everything
+  EXPECT_FALSE(reduceFrame(cloud, 1000000, FrameReading{0.0, 0, {}}));  // --voxel 0 keeps everything
 }
 
-TEST(FrameReduction, ACloudTooWideForVoxelGridIsFilteredInPartsWithTheSameVoxels) {
+TEST(FrameReading, ACloudTooWideForVoxelGridIsFilteredInPartsWithTheSameVoxels) {
   // 4 km by 4 km by 400 m at 1 cm: far beyond VoxelGrid's 2^31 voxels, which
   // would hand the cloud back unfiltered.
   pcl::PointCloud<pcl::PointXYZ> cloud = scattered(3000, 0.05f, 3);
   for (const auto& p : scattered(3000, 0.05f, 4)) cloud.push_back({p.x + 4000.0f, p.y - 4000.0f, p.z + 400.0f});
   const auto keys = voxelKeys(cloud, 0.01);
-  ASSERT_TRUE(reduceFrame(cloud, cloud.size(), FrameReduction{0.01, 0, {}}));
+  ASSERT_TRUE(reduceFrame(cloud, cloud.size(), FrameReading{0.01, 0, {}}));
   EXPECT_EQ(cloud.size(), keys.size());
   EXPECT_EQ(voxelKeys(cloud, 0.01), keys);
 }
 
-TEST(FrameReduction, TheFirstFailingFrameIsReportedOnAnyNumberOfThreads) {
+TEST(FrameReading, TheFirstFailingFrameIsReportedOnAnyNumberOfThreads) {
+  const auto read = [](std::size_t k) {
+    if (k == 7 || k == 30) throw InputError("frame " + std::to_string(k));
+  };
   for (int threads : {1, 2, 4}) {
     omp_set_num_threads(threads);
     std::vector<std::size_t> progress;
+    FrameReading reading;
+    reading.progress = [&](std::size_t done, std::size_t total) {
+      EXPECT_EQ(total, 50u);
+      progress.push_back(done);
+    };
     std::string message;
     try {
-      readFramesInParallel(
-          50,
-          [](std::size_t k) {
-            if (k == 7 || k == 30) throw InputError("frame " + std::to_string(k));
-          },
-          [&](std::size_t done, std::size_t total) {
-            EXPECT_EQ(total, 50u);
-            progress.push_back(done);
-          });
+      readFramesInParallel(50, read, reading);
     } catch (const InputError& e) {
       message = e.what();
     }
     EXPECT_EQ(message, "frame 7") << threads << " threads";
     EXPECT_TRUE(std::is_sorted(progress.begin(), progress.end()));
+    // --skip-bad-files: both left out, in frame order, the rest read.
+    reading.skip_bad_files = true;
+    progress.clear();
+    const std::vector<SkippedFrame> skipped = readFramesInParallel(50, read, reading);
+    ASSERT_EQ(skipped.size(), 2u) << threads << " threads";
+    EXPECT_EQ(skipped[0].index, 7u);
+    EXPECT_EQ(skipped[1].message, "frame 30");
+    EXPECT_EQ(progress.back(), 50u);
+    // Anything but a bad file still ends the read.
+    EXPECT_THROW(readFramesInParallel(50, [](std::size_t k) { if (k == 3) throw std::bad_alloc(); }, reading),
+                 std::bad_alloc);
   }
   omp_set_num_threads(omp_get_num_procs());
-  std::vector<std::size_t> read(100, 0);
-  readFramesInParallel(100, [&](std::size_t k) { read[k] = k + 1; }, {});
-  for (std::size_t k = 0; k < read.size(); ++k) EXPECT_EQ(read[k], k + 1);
+  std::vector<std::size_t> read_frames(100, 0);
+  readFramesInParallel(100, [&](std::size_t k) { read_frames[k] = k + 1; }, {});
+  for (std::size_t k = 0; k < read_frames.size(); ++k) EXPECT_EQ(read_frames[k], k + 1);
+  std::vector<int> values{0, 1, 2, 3, 4};
+  eraseSkipped(values, {{1, "a"}, {4, "b"}});
+  EXPECT_EQ(values, (std::vector<int>{0, 2, 3}));
+  EXPECT_EQ(skippedWarning({}, 5), "");
+  EXPECT_NE(skippedWarning({{1, "x.pcd: broken"}}, 5).find("left out 1 of 5 files that could not be read: x.pcd: broken"),
+            std::string::npos);
+  EXPECT_THROW(skippedWarning({{0, "a"}, {1, "b"}}, 2), InputError);
 }
 
 TEST_F(DatasetFolder, DepthFramesAreReducedAsTheyAreReadTheSameOnAnyNumberOfThreads) {
@@ -926,7 +944,7 @@ TEST_F(DatasetFolder, DepthFramesAreReducedAsTheyAreReadTheSameOnAnyNumberOfThre
   const DepthSequence whole = loadDepthSequence(dir_.string(), DepthLayout::Redwood, options);
   EXPECT_EQ(whole.reduced, 0u);
   EXPECT_EQ(whole.observations[0].cloud->size(), 24000u);
-  options.reduction = FrameReduction::denseDefault();
+  options.reduction = FrameReading::denseDefault();
   std::size_t calls = 0;
   options.reduction.progress = [&](std::size_t done, std::size_t total) {
     ++calls;
@@ -951,7 +969,7 @@ TEST_F(DatasetFolder, DepthFramesAreReducedAsTheyAreReadTheSameOnAnyNumberOfThre
   EXPECT_EQ(calls, 6u);
 }
 
-TEST(FrameReduction, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
+TEST(FrameReading, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
   for (float spread : {2.0f, 0.0f}) {  // 0: also two clusters 4 km apart, filtered in parts
     pcl::PointCloud<pcl::PointXYZI> cloud;
     for (const auto& p : scattered(30000, spread > 0 ? spread : 0.05f, 5)) cloud.push_back({p.x, p.y, p.z, 0.5f});
@@ -961,7 +979,7 @@ TEST(FrameReduction, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
     pcl::PCLPointCloud2 message;
     pcl::toPCLPointCloud2(cloud, message);
     const double leaf = spread > 0 ? 0.1 : 0.001;
-    const FrameReduction reduction{leaf, kDenseFramePoints, {}};
+    const FrameReading reduction{leaf, kDenseFramePoints, {}};
     ASSERT_TRUE(reduceFrame(message, reduction));
     pcl::PointCloud<pcl::PointXYZI> from_message;
     pcl::fromPCLPointCloud2(message, from_message);
@@ -979,8 +997,8 @@ TEST(FrameReduction, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
   // A light message, or one without float coordinates, is left as it is.
   pcl::PCLPointCloud2 light;
   pcl::toPCLPointCloud2(scattered(100, 1.0f, 7), light);
-  EXPECT_FALSE(reduceFrame(light, FrameReduction::denseDefault()));
+  EXPECT_FALSE(reduceFrame(light, FrameReading::denseDefault()));
   pcl::PCLPointCloud2 no_z = light;
   no_z.fields.pop_back();
-  EXPECT_FALSE(reduceFrame(no_z, FrameReduction{0.1, 0, {}}));
+  EXPECT_FALSE(reduceFrame(no_z, FrameReading{0.1, 0, {}}));
 }

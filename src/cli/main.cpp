@@ -5,7 +5,7 @@
 // or SIGTERM: the output folder is left as it was), 1 anything else.
 
 #include <obsgroup/io/errors.h>
-#include <obsgroup/io/frame_reduction.h>
+#include <obsgroup/io/frame_reading.h>
 #include "option_checks.h"
 #include "partition_command.h"
 
@@ -169,6 +169,14 @@ void addPcdOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->group("Poses (PCD sequences, depth images, KITTI, bags)");
 }
 
+/// Options of every folder of files.
+void addFolderOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  command.add_flag("--skip-bad-files", args.skip_bad_files,
+                   "PCD sequences, depth images, KITTI: leave out files that cannot be read, named in one warning "
+                   "(default: the first one ends the run)")
+      ->group("Folders of files (PCD sequences, depth images, KITTI)");
+}
+
 /// Options of depth image sequences.
 void addDepthOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--intrinsics", args.intrinsics, "depth images: pinhole fx,fy,cx,cy in pixels (default: "
@@ -293,6 +301,7 @@ void addPartitionOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) 
   addInputOptions(command, args);
   addCarmenOptions(command, args);
   addPcdOptions(command, args);
+  addFolderOptions(command, args);
   addDepthOptions(command, args);
   addBagOptions(command, args);
   addMethodOptions(command, args);
@@ -345,6 +354,7 @@ void addLocateOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, obs
   addInputOptions(command, args, "JSON file to write the locations to");
   addCarmenOptions(command, args);
   addPcdOptions(command, args);
+  addFolderOptions(command, args);
   addDepthOptions(command, args);
   addBagOptions(command, args);
   command.add_option("--tolerance", locate.tolerance,

@@ -106,6 +106,8 @@ void checkOptionsFit(const PartitionArgs& args, const std::string& format) {
   if (format != "carmen" && (args.laser != io::LaserSource::Auto || args.field_of_view_deg || args.max_range))
     throw io::UsageError("--laser, --fov and --max-range apply to CARMEN logs only");
   if (format != "carmen" && args.skip_bad_lines) throw io::UsageError("--skip-bad-lines applies to CARMEN logs only");
+  if (args.skip_bad_files && format != "pcd" && format != "tum-rgbd" && format != "redwood" && format != "kitti")
+    throw io::UsageError("--skip-bad-files applies to folders of files: PCD sequences, depth images and KITTI");
   if (!bag && (args.topic || args.pose_topic || args.fixed_frame))
     throw io::UsageError("--topic, --pose-topic and --fixed-frame apply to ROS bags only");
   if (args.pose_topic && args.fixed_frame)
@@ -129,14 +131,15 @@ class Warnings {
 
 /// How the readers of dense inputs reduce each frame: at --voxel when given,
 /// else dense frames at the default leaf; the bar counts the frames read.
-io::FrameReduction frameReduction(const PartitionArgs& args, ProgressBar& bar) {
-  io::FrameReduction reduction = args.voxel ? io::FrameReduction{*args.voxel, 0, {}} : io::FrameReduction::denseDefault();
+io::FrameReading frameReduction(const PartitionArgs& args, ProgressBar& bar) {
+  io::FrameReading reduction = args.voxel ? io::FrameReading{*args.voxel, 0, {}, false} : io::FrameReading::denseDefault();
+  reduction.skip_bad_files = args.skip_bad_files;
   reduction.progress = [&bar](std::size_t done, std::size_t total) { bar(done, total); };
   return reduction;
 }
 
 /// What partition.json records of the reduction: the leaf and how many frames it filtered.
-void recordReduction(const io::FrameReduction& reduction, std::size_t reduced, nlohmann::json& parameters) {
+void recordReduction(const io::FrameReading& reduction, std::size_t reduced, nlohmann::json& parameters) {
   parameters["frame_voxel"] = reduction.voxel_leaf;
   parameters["frame_voxel_min_points"] = reduction.min_points;
   parameters["frames_reduced"] = reduced;
@@ -732,12 +735,12 @@ int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointK
     }
   }
   ProgressBar bar("read", !args.quiet);
-  const io::FrameReduction reduction = frameReduction(args, bar);
+  const io::FrameReading reduction = frameReduction(args, bar);
   io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""), reduction);
   bar.finish();
   InputRecord input;
   input.format = "pcd";
-  input.labels = files;
+  input.labels = std::move(sequence.labels);
   input.parameters = {{"poses", args.poses ? nlohmann::json(*args.poses) : nlohmann::json("VIEWPOINT")},
                       {"pose_format", pose_format ? nlohmann::json(io::toString(*pose_format)) : nlohmann::json()},
                       {"point_type", io::toString(kind)}};
@@ -787,7 +790,7 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
 int runKitti(const PartitionArgs& args) {
   const auto start = Clock::now();
   ProgressBar bar("read", !args.quiet);
-  const io::FrameReduction reduction = frameReduction(args, bar);
+  const io::FrameReading reduction = frameReduction(args, bar);
   io::KittiSequence sequence = io::loadKittiSequence(args.input, args.poses, reduction);
   bar.finish();
   InputRecord input;
@@ -803,7 +806,7 @@ int runKitti(const PartitionArgs& args) {
 }
 
 template <typename PointT>
-int runBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::FrameReduction& reduction,
+int runBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::FrameReading& reduction,
              ProgressBar& bar, io::PointKind kind, Clock::time_point start) {
   io::BagSequenceOf<PointT> sequence = reader.observations<PointT>();
   bar.finish();

@@ -47,6 +47,9 @@ struct PartitionArgs {
   std::optional<double> field_of_view_deg;
   std::optional<double> max_range;
   bool skip_bad_lines = false;  ///< a bad line is a warning (counted), not an error
+  /// Folders of PCD files, depth images or KITTI sweeps: an unreadable file
+  /// is left out with a warning, not an error.
+  bool skip_bad_files = false;
   // PCD sequences
   std::optional<std::string> poses;
   std::optional<io::PoseFormat> pose_format;  ///< default: from the column count (8 tum, 12 kitti)

@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 #include <pcl/PCLPointCloud2.h>
 
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -92,13 +92,13 @@ struct Request {
   std::string data_topic;
   std::optional<std::string> pose_topic;
   bool tf = true;  ///< false when the poses come from elsewhere (a trajectory file): /tf is not read
-  const FrameReduction* reduction = nullptr;  ///< how each PointCloud2 is reduced as it is decoded
+  const FrameReading* reduction = nullptr;  ///< how each PointCloud2 is reduced as it is decoded
 };
 
 struct Messages {
   /// Set by the caller: each PointCloud2 is reduced so as it is decoded, so
   /// that a long recording is never held at full resolution.
-  const FrameReduction* reduce_clouds = nullptr;
+  const FrameReading* reduce_clouds = nullptr;
   std::vector<Numbered<Scan>> scans;
   std::vector<Numbered<Cloud>> clouds;
   std::vector<Numbered<Transform>> tf;         ///< /tf, every transform of every message
@@ -161,7 +161,7 @@ Messages readRos2Messages(const std::string& folder, const Request& request);
 
 /// Records the cloud's sensor points and reduces it as `reduction` says
 /// (null: kept whole).
-inline void keepReduced(Cloud& cloud, const FrameReduction* reduction) {
+inline void keepReduced(Cloud& cloud, const FrameReading* reduction) {
   cloud.sensor_points = std::size_t(cloud.cloud.width) * cloud.cloud.height;
   if (reduction) cloud.reduced = reduceFrame(cloud.cloud, *reduction);
 }

@@ -475,7 +475,7 @@ class PoseSource {
 
 template <typename PointT, typename Message>
 void addObservations(const std::vector<Numbered<Message>>& messages, const std::string& topic, PoseSource& poses,
-                     const std::string& bag_name, const FrameReduction& reduction, BagSequenceOf<PointT>& sequence) {
+                     const std::string& bag_name, const FrameReading& reduction, BagSequenceOf<PointT>& sequence) {
   std::size_t done = 0;
   for (const auto& [number, message] : messages) {
     if (reduction.progress) reduction.progress(++done, messages.size());

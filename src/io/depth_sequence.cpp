@@ -306,15 +306,21 @@ void readFrames(const std::vector<std::string>& files, const std::vector<Eigen::
   std::vector<Observation<pcl::PointXYZ>> observations(files.size());
   std::vector<std::string> warnings(files.size());
   std::vector<char> reduced(files.size(), 0);
-  readFramesInParallel(
+  const std::vector<SkippedFrame> skipped = readFramesInParallel(
       files.size(),
       [&](std::size_t k) {
         bool frame_reduced = false;
         observations[k] = readFrame(files[k], optical_poses[k], options, out.depth_scale, frame_reduced, warnings[k]);
         reduced[k] = frame_reduced;
       },
-      options.reduction.progress);
-  for (std::size_t k = 0; k < files.size(); ++k) {
+      options.reduction);
+  const std::string skipped_warning = skippedWarning(skipped, files.size());
+  if (!skipped_warning.empty()) out.warnings.push_back(skipped_warning);
+  for (std::size_t k = 0, next = 0; k < files.size(); ++k) {
+    if (next < skipped.size() && skipped[next].index == k) {
+      ++next;
+      continue;
+    }
     out.observations.push_back(std::move(observations[k]));
     out.labels.push_back(files[k]);
     if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));

@@ -66,7 +66,7 @@ Eigen::Isometry3d parseKittiCalibration(std::string_view content, const std::str
 }
 
 KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses_path,
-                                const FrameReduction& reduction) {
+                                const FrameReading& reduction) {
   const fs::path dir(folder);
   KittiSequence out;
   std::error_code ec;
@@ -102,12 +102,16 @@ KittiSequence loadKittiSequence(const std::string& folder, const std::optional<s
     cloud->sensor_orientation_ = Eigen::Quaternionf(pose.linear().cast<float>());
     out.observations[k] = {cloud, pose};
   };
-  readFramesInParallel(scans.size(), read, reduction.progress);
+  const std::vector<SkippedFrame> skipped = readFramesInParallel(scans.size(), read, reduction);
+  const std::string skipped_warning = skippedWarning(skipped, scans.size());
+  if (!skipped_warning.empty()) out.warnings.push_back(skipped_warning);
   out.labels = scans;
   for (std::size_t k = 0; k < scans.size(); ++k) {
     if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));
     out.reduced += reduced[k];
   }
+  eraseSkipped(out.observations, skipped);
+  eraseSkipped(out.labels, skipped);
   return out;
 }
 

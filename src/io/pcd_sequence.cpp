@@ -154,7 +154,7 @@ PointKind pointKindOfFields(const std::vector<pcl::PCLPointField>& fields) {
 template <typename PointT>
 PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
                                     const std::optional<std::vector<Eigen::Isometry3d>>& poses,
-                                    const std::string& poses_file, const FrameReduction& reduction) {
+                                    const std::string& poses_file, const FrameReading& reduction) {
   if (poses && poses->size() != files.size())
     throw InputError(poses_file + ": " + std::to_string(poses->size()) + " poses for " +
                      std::to_string(files.size()) + " PCD files (one pose per file, in name order)");
@@ -191,14 +191,19 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
     identity[k] = isIdentity(viewpoint);
     out.observations[k] = {cloud, poses ? (*poses)[k] : viewpoint};
   };
-  readFramesInParallel(files.size(), read, reduction.progress);
+  const std::vector<SkippedFrame> skipped = readFramesInParallel(files.size(), read, reduction);
+  const std::string skipped_warning = skippedWarning(skipped, files.size());
+  if (!skipped_warning.empty()) out.warnings.push_back(skipped_warning);
   std::size_t identity_viewpoints = 0;
   for (std::size_t k = 0; k < files.size(); ++k) {
     if (!warnings[k].empty()) out.warnings.push_back(std::move(warnings[k]));
     out.reduced += reduced[k];
     identity_viewpoints += identity[k];
   }
-  if (!poses && files.size() > 1 && identity_viewpoints == files.size())
+  out.labels = files;
+  eraseSkipped(out.observations, skipped);
+  eraseSkipped(out.labels, skipped);
+  if (!poses && out.observations.size() > 1 && identity_viewpoints == out.observations.size())
     out.warnings.push_back("every PCD VIEWPOINT is absent or the identity and no --poses was given: all "
                            "observations are at the origin, which is almost never what was meant");
   return out;
@@ -206,12 +211,12 @@ PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
 
 template PcdSequence<pcl::PointXYZ> loadPcdSequence(const std::vector<std::string>&,
                                                     const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                    const std::string&, const FrameReduction&);
+                                                    const std::string&, const FrameReading&);
 template PcdSequence<pcl::PointXYZI> loadPcdSequence(const std::vector<std::string>&,
                                                      const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                     const std::string&, const FrameReduction&);
+                                                     const std::string&, const FrameReading&);
 template PcdSequence<pcl::PointXYZRGB> loadPcdSequence(const std::vector<std::string>&,
                                                        const std::optional<std::vector<Eigen::Isometry3d>>&,
-                                                       const std::string&, const FrameReduction&);
+                                                       const std::string&, const FrameReading&);
 
 }  // namespace obsgroup::io

@@ -11,7 +11,7 @@
 // same points in the world, and the local maps and pose arrows then read as
 // from above.
 
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
 #include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
@@ -95,7 +95,7 @@ struct DepthOptions {
   std::optional<UpAxis> up;
   /// Each frame's reduction as it is read (a frame's sensor points: the
   /// image's pixels / stride^2), and the progress of the read.
-  FrameReduction reduction;
+  FrameReading reduction;
 };
 
 /// The points of an image; value 0 is no return, as is a depth beyond

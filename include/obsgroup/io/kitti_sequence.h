@@ -5,7 +5,7 @@
 // the world is the first velodyne frame (x ahead, y left, z up), not camera
 // 0's (z ahead, y down), so that z is up as obsgroup assumes.
 
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
 
 #include <obsgroup/cloud/observation.h>
 
@@ -43,6 +43,6 @@ struct KittiSequence {
 /// thread, each reduced as `reduction` says (its sensor points: the scan's)
 /// before the next is read.
 KittiSequence loadKittiSequence(const std::string& folder, const std::optional<std::string>& poses,
-                                const FrameReduction& reduction = {});
+                                const FrameReading& reduction = {});
 
 }  // namespace obsgroup::io

@@ -2,7 +2,7 @@
 // A folder of PCD files as a sequence of observations, each posed by its
 // VIEWPOINT or by a trajectory file.
 
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
 #include "obsgroup/io/pose_file.h"
 
 #include <obsgroup/cloud/observation.h>
@@ -44,6 +44,7 @@ PointKind detectPointKind(const std::string& file);
 template <typename PointT>
 struct PcdSequence {
   std::vector<Observation<PointT>> observations;
+  std::vector<std::string> labels;  ///< the file of each observation
   std::vector<std::string> warnings;
   std::size_t reduced = 0;  ///< clouds voxel-filtered as they were read
 };
@@ -58,6 +59,6 @@ struct PcdSequence {
 template <typename PointT>
 PcdSequence<PointT> loadPcdSequence(const std::vector<std::string>& files,
                                     const std::optional<std::vector<Eigen::Isometry3d>>& poses,
-                                    const std::string& poses_file = "", const FrameReduction& reduction = {});
+                                    const std::string& poses_file = "", const FrameReading& reduction = {});
 
 }  // namespace obsgroup::io

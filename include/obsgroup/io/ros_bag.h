@@ -7,7 +7,7 @@
 // bags in the default sqlite3 storage (a folder with metadata.yaml and
 // *.db3) with SQLite and Fast CDR. Neither needs a ROS installation.
 
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
 #include <obsgroup/cloud/observation.h>
 #include <obsgroup/common/enum_names.h>
 #include <obsgroup/io/pcd_sequence.h>
@@ -44,7 +44,7 @@ struct BagOptions {
   double max_time_difference = kDefaultMaxTimeDifference;  ///< seconds
   /// Each PointCloud2's reduction as it is converted (its sensor points:
   /// width x height), and the progress over the messages.
-  FrameReduction reduction;
+  FrameReading reduction;
 };
 
 /// The observations of a bag, with what was read and how.

@@ -1,4 +1,6 @@
-#include "obsgroup/io/frame_reduction.h"
+#include "obsgroup/io/frame_reading.h"
+
+#include "obsgroup/io/errors.h"
 
 #include <pcl/common/common.h>
 #include <pcl/common/io.h>
@@ -104,7 +106,7 @@ void filterInParts(const pcl::PCLPointCloud2& cloud, const pcl::Indices& indices
 
 }  // namespace
 
-bool reduceFrame(pcl::PCLPointCloud2& cloud, const FrameReduction& reduction) {
+bool reduceFrame(pcl::PCLPointCloud2& cloud, const FrameReading& reduction) {
   const std::size_t count = std::size_t(cloud.width) * cloud.height;
   if (count == 0 || !reduction.reduces(count)) return false;
   const long offsets[3] = {floatField(cloud, "x"), floatField(cloud, "y"), floatField(cloud, "z")};
@@ -145,10 +147,12 @@ bool reduceFrame(pcl::PCLPointCloud2& cloud, const FrameReduction& reduction) {
   return true;
 }
 
-void readFramesInParallel(std::size_t count, const std::function<void(std::size_t)>& read,
-                          const std::function<void(std::size_t, std::size_t)>& progress) {
+std::vector<SkippedFrame> readFramesInParallel(std::size_t count, const std::function<void(std::size_t)>& read,
+                                               const FrameReading& reading) {
   const std::int64_t n = static_cast<std::int64_t>(count);
   std::vector<std::exception_ptr> errors(count);
+  std::vector<std::string> skipped_because(count);
+  std::vector<char> skipped(count, 0);
   std::atomic<std::int64_t> first_failed{n};
   std::atomic<std::size_t> done{0};
   std::size_t reported = 0;  // the most frames reported: counts reach the critical section out of order
@@ -157,26 +161,51 @@ void readFramesInParallel(std::size_t count, const std::function<void(std::size_
     if (k > first_failed.load()) continue;
     try {
       read(std::size_t(k));
+    } catch (const InputError& e) {
+      if (reading.skip_bad_files) {
+        skipped[std::size_t(k)] = 1;
+        skipped_because[std::size_t(k)] = e.what();
+      } else {
+        errors[std::size_t(k)] = std::current_exception();
+      }
     } catch (...) {
       errors[std::size_t(k)] = std::current_exception();
+    }
+    if (errors[std::size_t(k)])
       for (std::int64_t seen = first_failed.load(); k < seen && !first_failed.compare_exchange_weak(seen, k);) {
       }
-    }
     const std::size_t frames = ++done;
-    if (progress) {
+    if (reading.progress) {
 #pragma omp critical(obsgroup_frame_progress)
       {
         reported = std::max(reported, frames);
-        progress(reported, count);
+        reading.progress(reported, count);
       }
     }
   }
   for (const auto& error : errors)
     if (error) std::rethrow_exception(error);
+  std::vector<SkippedFrame> out;
+  for (std::size_t k = 0; k < count; ++k)
+    if (skipped[k]) out.push_back({k, std::move(skipped_because[k])});
+  return out;
+}
+
+std::string skippedWarning(const std::vector<SkippedFrame>& skipped, std::size_t count) {
+  if (skipped.empty()) return "";
+  if (skipped.size() == count)
+    throw InputError("every one of the " + std::to_string(count) + " files failed to read; the first: " +
+                     skipped.front().message);
+  std::string text = "--skip-bad-files: left out " + std::to_string(skipped.size()) + " of " + std::to_string(count) +
+                     " files that could not be read: ";
+  const std::size_t named = std::min<std::size_t>(skipped.size(), 3);
+  for (std::size_t k = 0; k < named; ++k) text += (k ? "; " : "") + skipped[k].message;
+  if (skipped.size() > named) text += "; and " + std::to_string(skipped.size() - named) + " more";
+  return text;
 }
 
 template <typename PointT>
-bool reduceFrame(pcl::PointCloud<PointT>& cloud, std::size_t sensor_points, const FrameReduction& reduction) {
+bool reduceFrame(pcl::PointCloud<PointT>& cloud, std::size_t sensor_points, const FrameReading& reduction) {
   if (!reduction.reduces(sensor_points)) return false;
   pcl::PointCloud<PointT> finite;
   finite.reserve(cloud.size());
@@ -197,8 +226,8 @@ bool reduceFrame(pcl::PointCloud<PointT>& cloud, std::size_t sensor_points, cons
   return true;
 }
 
-template bool reduceFrame(pcl::PointCloud<pcl::PointXYZ>&, std::size_t, const FrameReduction&);
-template bool reduceFrame(pcl::PointCloud<pcl::PointXYZI>&, std::size_t, const FrameReduction&);
-template bool reduceFrame(pcl::PointCloud<pcl::PointXYZRGB>&, std::size_t, const FrameReduction&);
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZ>&, std::size_t, const FrameReading&);
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZI>&, std::size_t, const FrameReading&);
+template bool reduceFrame(pcl::PointCloud<pcl::PointXYZRGB>&, std::size_t, const FrameReading&);
 
 }  // namespace obsgroup::io
