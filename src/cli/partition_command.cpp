@@ -233,7 +233,10 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
   builder.setVoxelLeafSize(run.voxel);
   builder.setNumberOfThreads(args.method.threads);
   builder.setInterruptFlag(args.interrupt);
+  ProgressBar bar("local maps", !args.quiet);
+  builder.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   run.maps = builder.build(observations, partition, W);
+  bar.finish();
   std::vector<LocalMapFrame> frames;
   for (std::size_t g = 0; g < run.maps.size(); ++g) {
     frames.push_back(run.maps[g].frame);
@@ -268,12 +271,18 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   const bool planar = isPlanarData(world, sensorOrigins(observations, world), args.method.regions.cell_size);
   const render::HeightBand band{args.method.regions.band_low, args.method.regions.band_high};
   const render::HeightBand* slice = planar ? nullptr : &band;
+  ProgressBar bar("pictures", !args.quiet);
+  bar(0, 4);
   render::writeMapPictures(staged, world, posesOf(observations),
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
                            tinted ? &regions : nullptr, places, slice);
+  bar(1, 4);
   render::writeWeightsPicture(staged, grouped.W, partition);
+  bar(2, 4);
   render::writeFiedlerPicture(staged, partition);
+  bar(3, 4);
   render::writeLocalMapPictures(staged, maps.maps, args.method.threads, render::groupColours(maps.topology), slice);
+  bar(4, 4);
 }
 
 /// The settings the grouping ran with, as partition.json records them: only
@@ -352,7 +361,10 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
   const auto places_start = Clock::now();
+  ProgressBar bar("places", !args.quiet);
+  bar(0, 2);
   const ObservationRegions regions = regionsOfRun(args, grouped, observations);
+  bar(1, 2);
   PlaceOptions place_options;
   place_options.band_low = args.method.regions.band_low;
   place_options.band_high = args.method.regions.band_high;
@@ -371,6 +383,8 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
         if (grouped.place_ids[g] == place.id) place.members = of_every_frame.groups[g];
     writePlaces(out, written, warn);
   }
+  bar(2, 2);
+  bar.finish();
   t.places_s = secondsSince(places_start);
   if (args.pictures) {
     const auto pictures_start = Clock::now();

@@ -1,5 +1,6 @@
 #pragma once
-// A progress bar on stderr, shown only when stderr is a terminal.
+// A progress bar on stderr, shown only when stderr is a terminal: one line,
+// updated in place, that each stage of a run takes in turn.
 
 #include <unistd.h>
 
@@ -28,8 +29,10 @@ class ProgressBar {
     shown_ = true;
   }
 
+  /// Clears the line: every stage's bar takes the same line in turn, and
+  /// what follows (a warning, the summary) starts on a clean one.
   void finish() {
-    if (shown_) std::fprintf(stderr, "\n");
+    if (shown_) std::fprintf(stderr, "\r\033[K");
     shown_ = false;
   }
 

@@ -9,6 +9,7 @@
 #include "obsgroup/maps/topological_map.h"
 #include "obsgroup/cloud/observation.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,6 +58,11 @@ class LocalMapBuilder {
   /// A flag polled between groups; when set, build() throws Interrupted.
   void setInterruptFlag(const InterruptFlag* flag) { interrupt_ = flag; }
   const InterruptFlag* getInterruptFlag() const { return interrupt_; }
+  /// Called by the build of a partition with the maps done so far (never
+  /// fewer than the call before) and their total, one thread at a time.
+  void setProgressCallback(std::function<void(std::size_t done, std::size_t total)> progress) {
+    progress_ = std::move(progress);
+  }
 
   /// The local map of one group (observation indices, ascending); W chooses
   /// the reference and the pairs to align.
@@ -78,6 +84,7 @@ class LocalMapBuilder {
   RefinementParameters parameters_;
   double voxel_leaf_ = 0.05;
   int threads_ = 0;
+  std::function<void(std::size_t, std::size_t)> progress_;
   const InterruptFlag* interrupt_ = nullptr;
 };
 

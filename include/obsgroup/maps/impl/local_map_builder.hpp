@@ -6,6 +6,7 @@
 #include "obsgroup/cloud/finite_points.h"
 #include "obsgroup/common/parallel_for.h"
 
+#include <mutex>
 #include <pcl/common/common.h>
 #include <pcl/common/transforms.h>
 #include <pcl/filters/voxel_grid.h>
@@ -134,6 +135,8 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
   checkWeightMatrixSize("LocalMapBuilder::build", W, Eigen::Index(observations.size()));
   std::vector<LocalMap<PointT>> maps(partition.groups.size());
   const std::vector<Eigen::Isometry3d> poses = detail::posesOf(observations);  // once, not per group
+  std::mutex reporting;
+  std::size_t done = 0;
   parallelFor(partition.groups.size(), threads_, [&](std::size_t g) {
     if (interruptRequested(interrupt_)) return;
     const std::string name = "local map " + std::to_string(g) + ": ";
@@ -145,6 +148,10 @@ std::vector<LocalMap<PointT>> LocalMapBuilder<PointT>::build(const std::vector<O
       throw std::invalid_argument(name + e.what());
     } catch (const std::exception& e) {
       throw std::runtime_error(name + e.what());
+    }
+    if (progress_) {
+      const std::lock_guard<std::mutex> lock(reporting);
+      progress_(++done, partition.groups.size());
     }
   });
   throwIfInterrupted(interrupt_);
