@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Writes the README's sample partition.json from a real run of the main job
+"""Writes the user guide's sample partition.json from a real run of the main job
 (obsgroup partition data/office_2d/office.clf with the defaults), between the
-README's <!-- partition-json:begin --> and <!-- partition-json:end --> marks.
+docs/usage.md's <!-- partition-json:begin --> and <!-- partition-json:end --> marks.
 Long arrays are cut with "..."; everything else is the run's own values (the
 test suite checks the statistics against a run). Usage, from the repository:
   python3 scripts/readme-partition-sample.py [path/to/obsgroup]"""
@@ -58,10 +58,10 @@ lines = [
     "}",
     "```",
 ]
-readme = root / "README.md"
+readme = root / "docs" / "usage.md"
 text = readme.read_text()
 begin, end = "<!-- partition-json:begin -->", "<!-- partition-json:end -->"
 head, rest = text.split(begin)
 _, tail = rest.split(end)
 readme.write_text(head + begin + "\n" + "\n".join(lines) + "\n" + end + tail)
-print("README.md: sample partition.json from", p["input"])
+print("docs/usage.md: sample partition.json from", p["input"])

@@ -279,9 +279,9 @@ TEST_F(Cli, OfficeLogEndToEnd) {
   const nlohmann::json p = expectPartitionSchema(dir_ / "out", 77);
   expectAllOutputs(dir_ / "out", p);
 
-  // The README's sample is this run (scripts/readme-partition-sample.py):
+  // The user guide's sample is this run (scripts/readme-partition-sample.py):
   // its statistics, parameters and first groups are what the run gives.
-  const std::string readme = readFile(fs::path(kData).parent_path() / "README.md");
+  const std::string readme = readFile(fs::path(kData).parent_path() / "docs" / "usage.md");
   const std::size_t begin = readme.find("<!-- partition-json:begin -->");
   ASSERT_NE(begin, std::string::npos);
   const auto sampleObject = [&](const std::string& key) {
