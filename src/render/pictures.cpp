@@ -810,7 +810,21 @@ void drawFiedlerPlot(cairo_t* cr, const SplitNode& node, int index, double ox, d
   cairo_move_to(cr, ox, sy(node.threshold));
   cairo_line_to(cr, ox + w, sy(node.threshold));
   cairo_stroke(cr);
+  char value[32];
+  std::snprintf(value, sizeof value, "%.3g", node.threshold);
+  text(cr, ox + w - 48, sy(node.threshold) - 4, value, 10);  // inside the plot, above its line
+  // The y axis: its ends, and 0 where the range holds it, with ticks.
   cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_set_line_width(cr, 1);
+  std::vector<double> ticks{lo, hi};
+  if (lo < 0 && hi > 0 && std::min(sy(0) - sy(hi), sy(lo) - sy(0)) > 14) ticks.push_back(0.0);
+  for (double tick : ticks) {
+    cairo_move_to(cr, ox - 4, sy(tick));
+    cairo_line_to(cr, ox, sy(tick));
+    cairo_stroke(cr);
+    std::snprintf(value, sizeof value, "%.3g", tick);
+    text(cr, ox - 46, sy(tick) + 4, value, 10);
+  }
   char title[200];
   std::snprintf(title, sizeof title, "split %d: %zu observations, Ncut %.3f, %s", index, node.members.size(), node.ncut,
                 node.accepted ? "accepted" : "rejected");
