@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -177,6 +178,30 @@ void tintRegions(const ObservationRegions& regions, const Partition& partition, 
   }
 }
 
+/// Each cell of a place's floor in a pale shade of its group's colour (place
+/// g of group g): only where the place's observations saw free floor, not
+/// the wedges a view reaches through a door (buildPlaceMap drops them).
+/// The places are in the world frame; the view is re-centred on `origin`.
+void tintPlaces(const PlaceMap& places, const std::vector<int>& colours, const Eigen::Vector3d& origin,
+                const View& v, unsigned char* data, int stride) {
+  std::map<int, std::size_t> index_of;
+  for (std::size_t g = 0; g < places.places.size() && g < colours.size(); ++g) index_of[places.places[g].id] = g;
+  const FloorGrid& grid = places.grid;
+  const double cell = grid.resolution * v.scale;
+  for (int j = 0; j < grid.height; ++j)
+    for (int i = 0; i < grid.width; ++i) {
+      const auto it = index_of.find(places.labels[grid.index(i, j)]);
+      if (it == index_of.end()) continue;
+      const Eigen::Vector2d c = grid.cellCentre(i, j);
+      const double x0 = v.px(c.x() - origin.x()) - cell / 2, y0 = v.py(c.y() - origin.y()) - cell / 2;
+      const std::uint32_t argb = argbOf(pale(paletteColour(colours[it->second])));
+      // Cells tile the picture: each fills the pixels whose centres it holds.
+      for (int y = std::max(0, int(std::ceil(y0 - 0.5))); y < std::min(v.height, int(std::ceil(y0 + cell - 0.5))); ++y)
+        for (int x = std::max(0, int(std::ceil(x0 - 0.5))); x < std::min(v.width, int(std::ceil(x0 + cell - 0.5))); ++x)
+          reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = argb;
+    }
+}
+
 /// One pixel per point, or a 2x2 block when they are few (fewer than 300000).
 int dotSize(std::size_t points) { return points < 300000 ? 2 : 1; }
 
@@ -255,7 +280,7 @@ WorldPoints withinBand(const WorldPoints& world, const std::vector<double>& heig
 /// on a transparent background above the legend. With a band, each
 /// observation's points are drawn by height above its sensor (`heights`).
 Surface rasterPoints(const WorldPoints& world, const Partition& partition, const MapLayout& layout,
-                     const ObservationRegions* regions, const HeightBand* band = nullptr,
+                     const ObservationRegions* regions, const PlaceMap* places, const HeightBand* band = nullptr,
                      const std::vector<double>& heights = {}) {
   View v = layout.view;
   v.height = layout.legend_top;
@@ -263,7 +288,10 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
   cairo_surface_flush(surface.get());
   unsigned char* data = cairo_image_surface_get_data(surface.get());
   const int stride = cairo_image_surface_get_stride(surface.get());
-  if (regions) tintRegions(*regions, partition, layout.colours, v, data, stride);
+  if (regions && places)
+    tintPlaces(*places, layout.colours, world.origin, v, data, stride);
+  else if (regions)
+    tintRegions(*regions, partition, layout.colours, v, data, stride);
   const int dot = dotSize(world.points.size());
   if (band) {
     HeightBuffer buffer(v, *band);
@@ -508,7 +536,9 @@ void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendTex
     cairo_rectangle(cr, x, row - 6, 12, 12);
     cairo_fill(cr);
     cairo_set_source_rgb(cr, 0, 0, 0);
-    text(cr, x + 18, row + 4, "space sensed, tinted by the group holding it most", 12);
+    text(cr, x + 18, row + 4,
+         t.places ? "each place's floor: free space its observations sensed" : "space sensed, tinted by the group holding it most",
+         12);
   }
   char caption[240], outside[64] = "";
   if (t.outside > 0)
@@ -745,7 +775,7 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
   }
   const MapLayout layout = layoutOf(world, positions, partition, topology);
   // The regions describe the input poses (they gave W) and stay there.
-  const Surface points = rasterPoints(world, partition, layout, regions, band, heights);
+  const Surface points = rasterPoints(world, partition, layout, regions, places, band, heights);
   const auto draw = [&](cairo_surface_t* target) {
     Context cr(cairo_create(target), cairo_destroy);
     drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr, places,
