@@ -699,11 +699,47 @@ void drawMemberPoses(cairo_t* cr, const View& v, const LocalMapFrame& frame, con
 
 /// local_maps/group_NNN.png of one local map, whose points (in its frame)
 /// are given without the non-finite ones.
+/// How far around its members' positions a local map's picture frames the
+/// place, metres: the visibility model's default range, how far the
+/// grouping itself looks. Returns beyond it (through a door, a window) are
+/// ticks on the picture's edge, so that they do not shrink the place.
+constexpr double kPlaceReach = 6.0;
+
+/// Points outside the view as ticks on its edge, where a line from the
+/// view's centre towards them leaves it, in a darker shade.
+std::size_t tickFarPoints(const View& v, const std::vector<Eigen::Vector3f>& points, const Rgb& colour,
+                          unsigned char* data, int stride) {
+  const std::uint32_t argb = argbOf(darker(colour));
+  const double bottom = v.height - 30.0;  // the drawing ends above the caption
+  const double cx = v.width / 2.0, cy = bottom / 2.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  std::size_t ticked = 0;
+  for (const Eigen::Vector3f& p : points) {
+    const double x = v.px(p.x()), y = v.py(p.y());
+    if (x >= 0 && y >= 0 && x < v.width && y < bottom) continue;
+    const double dx = x - cx, dy = y - cy;
+    const double t = std::min(dx != 0 ? (cx - 2) / std::abs(dx) : inf, dy != 0 ? (cy - 2) / std::abs(dy) : inf);
+    const int ex = int(std::clamp(cx + dx * t, 0.0, v.width - 3.0)), ey = int(std::clamp(cy + dy * t, 0.0, bottom - 3.0));
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) reinterpret_cast<std::uint32_t*>(data + (ey + b) * stride)[ex + a] = argb;
+    ++ticked;
+  }
+  return ticked;
+}
+
 void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFrame& frame,
                           const std::vector<Eigen::Vector3f>& points, const Rgb& colour, const HeightBand* band) {
   std::vector<Eigen::Vector2d> positions(frame.member_poses.size());
-  for (std::size_t k = 0; k < positions.size(); ++k) positions[k] = frame.member_poses[k].translation().head<2>();
-  const View v = fitView(bulkBox(points.data(), points.data() + points.size(), positions, 0.005), 700.0, 520, 20);
+  Eigen::AlignedBox2d reach;
+  for (std::size_t k = 0; k < positions.size(); ++k) {
+    positions[k] = frame.member_poses[k].translation().head<2>();
+    reach.extend(positions[k]);
+  }
+  reach = Eigen::AlignedBox2d(reach.min().array() - kPlaceReach, reach.max().array() + kPlaceReach);
+  std::vector<Eigen::Vector3f> near;
+  for (const Eigen::Vector3f& p : points)
+    if (reach.contains(p.head<2>().cast<double>())) near.push_back(p);
+  const View v = fitView(bulkBox(near.data(), near.data() + near.size(), positions, 0.005), 700.0, 640, 20);
   Surface surface = imageSurface(v.width, v.height);
   Context cr(cairo_create(surface.get()), cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
@@ -716,13 +752,15 @@ void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFra
                                 data, stride);
   else
     plotPoints(v, points.data(), points.data() + points.size(), argbOf(colour), dotSize(points.size()), data, stride);
+  const std::size_t ticked = tickFarPoints(v, points, colour, data, stride);
   cairo_surface_mark_dirty(surface.get());
   drawMemberPoses(cr.get(), v, frame, colour);
   drawScaleBar(cr.get(), v.scale, (v.width - 2 * v.margin) / 5.0, v.width - v.margin, v.margin / 2);
   cairo_set_source_rgb(cr.get(), 0, 0, 0);
-  char caption[200];
-  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points; ringed: reference %d",
-                group, frame.members.size(), points.size(), frame.reference);
+  char caption[240], far[80] = "";
+  if (ticked > 0) std::snprintf(far, sizeof far, " (%zu far: ticks on the edge)", ticked);
+  std::snprintf(caption, sizeof caption, "local map %d: %zu observations, %zu points%s; ringed: reference %d", group,
+                frame.members.size(), points.size(), far, frame.reference);
   text(cr.get(), v.margin, v.height - 12, caption, 12);
   char name[64];
   std::snprintf(name, sizeof name, "local_maps/group_%03d.png", group);

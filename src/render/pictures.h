@@ -90,9 +90,11 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& world, const 
 /// local_maps/group_NNN.png, numbered like writeLocalMaps' PCD files: each
 /// local map's merged points from above in the map's own frame (x right, y
 /// up), its members' poses as arrows, the reference's drawn black in a ring,
-/// and a scale bar, cropped to the bulk of its points (all but the 0.5% at
-/// either end on each axis: fewer are far returns than in map.png); about
-/// 780 px on the long side. Group g is drawn in colour `colours[g]`
+/// and a scale bar, framing the place: the points within 6 m of its
+/// members' positions (all but the 0.5% of them at either end on each axis);
+/// returns beyond (through a door, a window) are ticks on the picture's edge
+/// in the direction they lie, counted in the caption. About 780 px on the
+/// long side. Group g is drawn in colour `colours[g]`
 /// (groupColours(), as in map.png; empty: g). Written on `threads` threads
 /// (<= 0: all); each picture is the same for any number. With a height band
 /// (3D input), heights are taken above the map's reference sensor.
