@@ -84,6 +84,28 @@ Grouped groupAndPlace(const sim::Building& building, std::size_t every = 1) {
   return out;
 }
 
+TEST(Places, TheRegionsTheGroupingKeepsAreThoseItWouldComputeAndGiveTheSameGroups) {
+  const sim::Building office = sim::makeBuilding("office");
+  const auto observations = test::simulate<pcl::PointXYZ>(office.plan, office.route, sim::laser360());
+  ObservationGrouping<pcl::PointXYZ> plain, keeping;
+  keeping.setKeepRegions(true);
+  for (const auto& o : observations) {
+    plain.addObservation(o.cloud, o.pose);
+    keeping.addObservation(o.cloud, o.pose);
+  }
+  EXPECT_EQ(plain.compute().groups, keeping.compute().groups);
+  EXPECT_EQ(plain.getWeightMatrix().toDense(), keeping.getWeightMatrix().toDense());
+  EXPECT_EQ(plain.getRegions().size(), 0);  // not kept unless asked
+  const ObservationRegions again =
+      keeping.getSensedSpaceOverlap().computeRegions(observations, keeping.getSensedSpaceOverlap().toWorld(observations));
+  EXPECT_EQ(keeping.getRegions().cells, again.cells);
+  EXPECT_EQ(keeping.getRegions().offsets, again.offsets);
+  // The points model has no regions.
+  keeping.setParameters(GroupingParameters::paper());
+  keeping.compute();
+  EXPECT_EQ(keeping.getRegions().size(), 0);
+}
+
 TEST(Places, OutlinesAreValidPolygonsAndDoorsJoinNeighbours) {
   const Grouped g = groupAndPlace(sim::makeBuilding("office"));
   const PlaceMap& map = g.places;

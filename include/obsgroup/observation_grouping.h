@@ -151,6 +151,15 @@ class ObservationGrouping {
   bool getKeepWorldPoints() const { return keep_world_points_; }
   /// The points kept by the last compute() (empty unless setKeepWorldPoints(true)).
   const WorldPoints& getWorldPoints() const { return world_; }
+  /// Keep the sensed regions the overlap was measured on (free-space and
+  /// visibility models) after compute(), to draw them or cut places from
+  /// them without computing them again: off by default (they are the largest
+  /// part of the overlap stage's memory).
+  void setKeepRegions(bool keep) { keep_regions_ = keep; }
+  bool getKeepRegions() const { return keep_regions_; }
+  /// The regions kept by the last compute() (empty unless setKeepRegions(true)
+  /// and a region model).
+  const ObservationRegions& getRegions() const { return regions_; }
   /// Time spent in each stage of the last compute().
   const GroupingTimings& getTimings() const { return timings_; }
   /// What the user should know about the last compute(), deterministic and
@@ -168,6 +177,8 @@ class ObservationGrouping {
   WeightMatrix W_;
   bool keep_world_points_ = false;
   WorldPoints world_;
+  bool keep_regions_ = false;
+  ObservationRegions regions_;
   GroupingTimings timings_;
   std::vector<std::string> warnings_;
 };

@@ -169,6 +169,7 @@ void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& g
   grouping.setInterruptFlag(args.interrupt);
   grouping.setParameters(args.method);
   grouping.setKeepWorldPoints(true);  // the places and map.png are drawn from them
+  grouping.setKeepRegions(true);      // and cut from these
 }
 
 /// Groups the observations at once: the overlap, W and the partition (sec. II-III).
@@ -363,7 +364,11 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   const auto places_start = Clock::now();
   ProgressBar bar("places", !args.quiet);
   bar(0, 2);
-  const ObservationRegions regions = regionsOfRun(args, grouped, observations);
+  // The grouping's own regions when it kept them (partition); computed here otherwise (stream, points model).
+  const ObservationRegions& kept = grouped.grouping.getRegions();
+  ObservationRegions computed;
+  if (kept.size() != int(observations.size())) computed = regionsOfRun(args, grouped, observations);
+  const ObservationRegions& regions = kept.size() == int(observations.size()) ? kept : computed;
   bar(1, 2);
   PlaceOptions place_options;
   place_options.band_low = args.method.regions.band_low;

@@ -5,6 +5,7 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <png.h>
 #include <pcl/point_types.h>
 
 #include <omp.h>
@@ -57,10 +58,61 @@ Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
 }
 
+/// Writes rows of 8-bit RGB or RGBA (`channels`) to `file` with libpng:
+/// zlib level 1 and the Sub filter, which suit flat drawings (cairo's own
+/// writer, at the default level with every filter tried, spent most of a
+/// run's picture time compressing). libpng reports errors by longjmp, so this
+/// function holds nothing that needs a destructor; returns false on an error.
+bool encodePng(std::FILE* file, int width, int height, int channels, const png_byte* pixels) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
+               channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, 1);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+  png_write_info(png, info);
+  for (int r = 0; r < height; ++r) png_write_row(png, pixels + std::size_t(r) * std::size_t(width) * channels);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+/// An ARGB32 image surface as a PNG: RGB when every pixel is opaque, else
+/// RGBA with cairo's premultiplied alpha undone.
 void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t* surface) {
-  out(name, [surface](const std::string& temporary) {
-    if (cairo_surface_write_to_png(surface, temporary.c_str()) != CAIRO_STATUS_SUCCESS)
-      throw std::runtime_error(temporary + ": cairo cannot write the PNG");
+  cairo_surface_flush(surface);
+  const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  const unsigned char* data = cairo_image_surface_get_data(surface);
+  bool opaque = true;
+  for (int y = 0; y < height && opaque; ++y)
+    for (int x = 0; x < width && opaque; ++x)
+      opaque = (reinterpret_cast<const std::uint32_t*>(data + y * stride)[x] >> 24) == 0xff;
+  const int channels = opaque ? 3 : 4;
+  std::vector<png_byte> pixels(std::size_t(width) * height * channels);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::uint32_t argb = reinterpret_cast<const std::uint32_t*>(data + y * stride)[x];
+      const unsigned a = argb >> 24;
+      png_byte* p = &pixels[(std::size_t(y) * width + x) * channels];
+      for (int c = 0; c < 3; ++c) {
+        const unsigned value = (argb >> (16 - 8 * c)) & 0xff;
+        p[c] = png_byte(a == 0 ? 0 : opaque ? value : std::min(255u, (value * 255 + a / 2) / a));
+      }
+      if (!opaque) p[3] = png_byte(a);
+    }
+  out(name, [&](const std::string& temporary) {
+    std::FILE* file = std::fopen(temporary.c_str(), "wb");
+    const bool written = file && encodePng(file, width, height, channels, pixels.data());
+    if (file && std::fclose(file) != 0) throw std::runtime_error(temporary + ": cannot write the PNG");
+    if (!written) throw std::runtime_error(temporary + ": cannot write the PNG");
   });
 }
 

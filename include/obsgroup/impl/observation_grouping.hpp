@@ -51,9 +51,12 @@ Partition ObservationGrouping<PointT>::compute() {
   auto start = Clock::now();
   const SensedSpaceOverlap<PointT> overlap = getSensedSpaceOverlap();
   world_ = WorldPoints{};
+  regions_ = ObservationRegions{};
   if (keep_world_points_) {
     world_ = overlap.toWorld(observations_);
-    overlap_result_ = overlap.compute(observations_, world_);
+    overlap_result_ = overlap.compute(observations_, world_, keep_regions_ ? &regions_ : nullptr);
+  } else if (keep_regions_) {
+    overlap_result_ = overlap.compute(observations_, overlap.toWorld(observations_), &regions_);
   } else {
     overlap_result_ = overlap.compute(observations_);
   }

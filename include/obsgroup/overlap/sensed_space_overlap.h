@@ -95,8 +95,13 @@ class SensedSpaceOverlap {
   /// Pi and Psi for all pairs. Throws std::invalid_argument on bad parameters.
   OverlapResult compute(const std::vector<Observation<PointT>>& observations) const;
   /// The same from the observations' points already in the common frame
-  /// (toWorld(observations)), e.g. kept to draw them afterwards.
-  OverlapResult compute(const std::vector<Observation<PointT>>& observations, const WorldPoints& world) const;
+  /// (toWorld(observations)), e.g. kept to draw them afterwards. With
+  /// `regions` (free-space and visibility models), the regions the overlap is
+  /// measured on are kept there, as computeRegions() gives them, so that a
+  /// caller who draws them or cuts places from them does not compute them
+  /// again (the result is the same; the regions are held until it returns).
+  OverlapResult compute(const std::vector<Observation<PointT>>& observations, const WorldPoints& world,
+                        ObservationRegions* regions = nullptr) const;
 
  private:
   MatchCounts countMatchesPclSearch(const WorldPoints& world) const;

@@ -189,7 +189,7 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
 
 template <typename PointT>
 OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<PointT>>& observations,
-                                                  const WorldPoints& world) const {
+                                                  const WorldPoints& world, ObservationRegions* regions) const {
   if (!(delta_ > 0.0) || !std::isfinite(delta_))
     throw std::invalid_argument("match distance delta must be finite and > 0");
   if (world.size() != static_cast<int>(observations.size()))
@@ -199,13 +199,20 @@ OverlapResult SensedSpaceOverlap<PointT>::compute(const std::vector<Observation<
     if (progress_) progress_(0, observations.size());
     std::vector<Eigen::Vector3d> origins(observations.size());
     for (std::size_t i = 0; i < observations.size(); ++i) origins[i] = observations[i].pose.translation() - world.origin;
-    OverlapResult result = computeRegionOverlap(model_, world, origins, region_, threads_, interrupt_);
+    OverlapResult result;
+    if (regions) {
+      *regions = obsgroup::computeRegions(model_, world, origins, region_, threads_, interrupt_);
+      result = regionOverlap(*regions, threads_, interrupt_);
+    } else {
+      result = computeRegionOverlap(model_, world, origins, region_, threads_, interrupt_);
+    }
     result.region_cells = std::move(result.points_per_observation);
     result.points_per_observation.resize(observations.size());
     for (int i = 0; i < world.size(); ++i) result.points_per_observation[i] = world.count(i);
     if (progress_) progress_(observations.size(), observations.size());
     return result;
   }
+  if (regions) *regions = ObservationRegions{};  // the points model has none
   const MatchCounts counts = neighbour_search_ == NeighbourSearch::SharedGrid
                                  ? countMatchesSharedGrid(world, delta_, threads_, progress_, interrupt_)
                                  : countMatchesPclSearch(world);
