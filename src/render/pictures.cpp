@@ -58,12 +58,14 @@ Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
 }
 
-/// Writes rows of 8-bit RGB or RGBA (`channels`) to `file` with libpng:
-/// zlib level 1 and the Sub filter, which suit flat drawings (cairo's own
-/// writer, at the default level with every filter tried, spent most of a
-/// run's picture time compressing). libpng reports errors by longjmp, so this
-/// function holds nothing that needs a destructor; returns false on an error.
-bool encodePng(std::FILE* file, int width, int height, int channels, const png_byte* pixels) {
+/// Writes `height` rows of `row_bytes` each to `file` with libpng: 8-bit
+/// RGBA (`opaque_bgrx` false), or cairo's opaque ARGB32 rows as they lie in
+/// memory (B, G, R, unused on a little-endian machine) written as RGB. zlib
+/// level 1 and the Sub filter suit flat drawings (cairo's own writer, at the
+/// default level with every filter tried, spent most of a run's picture time
+/// compressing). libpng reports errors by longjmp, so this function holds
+/// nothing that needs a destructor; returns false on an error.
+bool encodePng(std::FILE* file, int width, int height, bool opaque_bgrx, const png_byte* rows, std::size_t row_bytes) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
@@ -73,12 +75,16 @@ bool encodePng(std::FILE* file, int width, int height, int channels, const png_b
   }
   png_init_io(png, file);
   png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
-               channels == 4 ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               opaque_bgrx ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_compression_level(png, 1);
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   png_write_info(png, info);
-  for (int r = 0; r < height; ++r) png_write_row(png, pixels + std::size_t(r) * std::size_t(width) * channels);
+  if (opaque_bgrx) {
+    png_set_filler(png, 0, PNG_FILLER_AFTER);  // the unused fourth byte of each pixel is dropped
+    png_set_bgr(png);
+  }
+  for (int r = 0; r < height; ++r) png_write_row(png, rows + std::size_t(r) * row_bytes);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return true;
@@ -95,22 +101,29 @@ void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t
   for (int y = 0; y < height && opaque; ++y)
     for (int x = 0; x < width && opaque; ++x)
       opaque = (reinterpret_cast<const std::uint32_t*>(data + y * stride)[x] >> 24) == 0xff;
-  const int channels = opaque ? 3 : 4;
-  std::vector<png_byte> pixels(std::size_t(width) * height * channels);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const std::uint32_t argb = reinterpret_cast<const std::uint32_t*>(data + y * stride)[x];
-      const unsigned a = argb >> 24;
-      png_byte* p = &pixels[(std::size_t(y) * width + x) * channels];
-      for (int c = 0; c < 3; ++c) {
-        const unsigned value = (argb >> (16 - 8 * c)) & 0xff;
-        p[c] = png_byte(a == 0 ? 0 : opaque ? value : std::min(255u, (value * 255 + a / 2) / a));
+  // An opaque little-endian surface is written from its own rows; otherwise
+  // as RGBA with cairo's premultiplied alpha undone.
+  const bool as_is = opaque && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+  std::vector<png_byte> pixels;
+  if (!as_is) {
+    pixels.resize(std::size_t(width) * height * 4);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::uint32_t argb = reinterpret_cast<const std::uint32_t*>(data + y * stride)[x];
+        const unsigned a = argb >> 24;
+        png_byte* p = &pixels[(std::size_t(y) * width + x) * 4];
+        for (int c = 0; c < 3; ++c) {
+          const unsigned value = (argb >> (16 - 8 * c)) & 0xff;
+          p[c] = png_byte(a == 0 ? 0 : std::min(255u, (value * 255 + a / 2) / a));
+        }
+        p[3] = png_byte(a);
       }
-      if (!opaque) p[3] = png_byte(a);
-    }
+  }
   out(name, [&](const std::string& temporary) {
     std::FILE* file = std::fopen(temporary.c_str(), "wb");
-    const bool written = file && encodePng(file, width, height, channels, pixels.data());
+    const bool written =
+        file && (as_is ? encodePng(file, width, height, true, data, std::size_t(stride))
+                       : encodePng(file, width, height, false, pixels.data(), std::size_t(width) * 4));
     if (file && std::fclose(file) != 0) throw std::runtime_error(temporary + ": cannot write the PNG");
     if (!written) throw std::runtime_error(temporary + ": cannot write the PNG");
   });
