@@ -3,7 +3,7 @@
 #include <obsgroup/io/errors.h>
 
 #include <nlohmann/json.hpp>
-#include <png.h>
+#include "png_rows.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -117,32 +117,6 @@ std::string mapYaml(const PlaceMap& map, const std::string& image, const std::st
   return out.str();
 }
 
-namespace {
-
-/// Writes a one-channel PNG from rows top first, `bytes_per_row` each. libpng
-/// reports errors by longjmp, so this function holds nothing that needs a
-/// destructor; returns false on an error.
-bool writeGreyPng(std::FILE* file, int width, int height, int bit_depth, const png_byte* pixels,
-                  std::size_t bytes_per_row) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  if (!png) return false;
-  png_infop info = png_create_info_struct(png);
-  if (!info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    return false;
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), bit_depth, PNG_COLOR_TYPE_GRAY,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int r = 0; r < height; ++r) png_write_row(png, pixels + std::size_t(r) * bytes_per_row);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return true;
-}
-
-}  // namespace
-
 void writePlaceLabels(const std::string& path, const PlaceMap& map) {
   const int width = std::max(1, map.grid.width), height = std::max(1, map.grid.height);
   int largest = -1;
@@ -166,7 +140,8 @@ void writePlaceLabels(const std::string& path, const PlaceMap& map) {
   }
   std::FILE* file = std::fopen(path.c_str(), "wb");
   if (!file) throw std::runtime_error(path + ": cannot write");
-  const bool written = writeGreyPng(file, width, height, bit_depth, pixels.data(), bytes_per_row);
+  const bool written =
+      render::writePngRows(file, width, height, bit_depth, render::PngPixels::Grey, pixels.data(), bytes_per_row, false);
   if (std::fclose(file) != 0 || !written) throw std::runtime_error(path + ": cannot write the label map");
 }
 

@@ -1,11 +1,11 @@
 #include "pictures.h"
+#include "png_rows.h"
 
 #include <obsgroup/cloud/finite_points.h>
 #include <obsgroup/common/parallel_for.h>
 
 #include <cairo-svg.h>
 #include <cairo.h>
-#include <png.h>
 #include <pcl/point_types.h>
 
 #include <omp.h>
@@ -58,38 +58,6 @@ Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
 }
 
-/// Writes `height` rows of `row_bytes` each to `file` with libpng: 8-bit
-/// RGBA (`opaque_bgrx` false), or cairo's opaque ARGB32 rows as they lie in
-/// memory (B, G, R, unused on a little-endian machine) written as RGB. zlib
-/// level 1 and the Sub filter suit flat drawings (cairo's own writer, at the
-/// default level with every filter tried, spent most of a run's picture time
-/// compressing). libpng reports errors by longjmp, so this function holds
-/// nothing that needs a destructor; returns false on an error.
-bool encodePng(std::FILE* file, int width, int height, bool opaque_bgrx, const png_byte* rows, std::size_t row_bytes) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  if (!png) return false;
-  png_infop info = png_create_info_struct(png);
-  if (!info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    return false;
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
-               opaque_bgrx ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_set_compression_level(png, 1);
-  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
-  png_write_info(png, info);
-  if (opaque_bgrx) {
-    png_set_filler(png, 0, PNG_FILLER_AFTER);  // the unused fourth byte of each pixel is dropped
-    png_set_bgr(png);
-  }
-  for (int r = 0; r < height; ++r) png_write_row(png, rows + std::size_t(r) * row_bytes);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  return true;
-}
-
 /// An ARGB32 image surface as a PNG: RGB when every pixel is opaque, else
 /// RGBA with cairo's premultiplied alpha undone.
 void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t* surface) {
@@ -122,8 +90,9 @@ void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t
   out(name, [&](const std::string& temporary) {
     std::FILE* file = std::fopen(temporary.c_str(), "wb");
     const bool written =
-        file && (as_is ? encodePng(file, width, height, true, data, std::size_t(stride))
-                       : encodePng(file, width, height, false, pixels.data(), std::size_t(width) * 4));
+        file && (as_is ? writePngRows(file, width, height, 8, PngPixels::OpaqueBgrx, data, std::size_t(stride), true)
+                       : writePngRows(file, width, height, 8, PngPixels::Rgba, pixels.data(), std::size_t(width) * 4,
+                                      true));
     if (file && std::fclose(file) != 0) throw std::runtime_error(temporary + ": cannot write the PNG");
     if (!written) throw std::runtime_error(temporary + ": cannot write the PNG");
   });

@@ -31,32 +31,12 @@ typename pcl::PointCloud<PointT>::Ptr scanCloud(const FloorPlan& plan, const Pos
   return toCloud<PointT>(scanToPoints(plan.scan(pose, laser, seed), laser));
 }
 
-/// One depth image of `plan` as a cloud in the camera frame, its pose (the
-/// camera standing over `pose`) in the cloud's sensor origin and orientation,
-/// as a PCD file's VIEWPOINT stores it.
+/// 3D points in the sensor frame as a cloud whose sensor origin stands
+/// `height` over `pose`, facing its heading (a PCD file's VIEWPOINT).
 template <typename PointT>
-typename pcl::PointCloud<PointT>::Ptr depthCloud(const FloorPlan& plan, const Pose2D& pose, const DepthCamera& camera,
-                                                 std::uint64_t seed) {
+typename pcl::PointCloud<PointT>::Ptr sensorCloud(const std::vector<Eigen::Vector3d>& points, const Pose2D& pose,
+                                                  double height) {
   typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
-  for (const auto& q : plan.depthImage(pose, camera, seed)) {
-    PointT p;
-    p.x = static_cast<float>(q.x());
-    p.y = static_cast<float>(q.y());
-    p.z = static_cast<float>(q.z());
-    cloud->push_back(p);
-  }
-  cloud->sensor_origin_ << float(pose.x), float(pose.y), float(camera.height_above_floor), 0.0f;
-  cloud->sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(pose.yaw), Eigen::Vector3f::UnitZ()));
-  return cloud;
-}
-
-/// One lidar sweep as a cloud in the sensor frame (x ahead, y left, z up),
-/// its sensor origin `lidar.height_above_floor` over the pose.
-template <typename PointT>
-typename pcl::PointCloud<PointT>::Ptr lidarCloud(const FloorPlan& plan, const Pose2D& pose, const Lidar& lidar,
-                                                 std::uint64_t seed) {
-  typename pcl::PointCloud<PointT>::Ptr cloud(new pcl::PointCloud<PointT>);
-  const auto points = plan.lidarSweep(pose, lidar, seed);
   cloud->reserve(points.size());
   for (const auto& q : points) {
     PointT p;
@@ -65,9 +45,26 @@ typename pcl::PointCloud<PointT>::Ptr lidarCloud(const FloorPlan& plan, const Po
     p.z = static_cast<float>(q.z());
     cloud->push_back(p);
   }
-  cloud->sensor_origin_ << float(pose.x), float(pose.y), float(lidar.height_above_floor), 0.0f;
+  cloud->sensor_origin_ << float(pose.x), float(pose.y), float(height), 0.0f;
   cloud->sensor_orientation_ = Eigen::Quaternionf(Eigen::AngleAxisf(float(pose.yaw), Eigen::Vector3f::UnitZ()));
   return cloud;
+}
+
+/// One depth image of `plan` as a cloud in the camera frame, its pose (the
+/// camera standing over `pose`) in the cloud's sensor origin and orientation,
+/// as a PCD file's VIEWPOINT stores it.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr depthCloud(const FloorPlan& plan, const Pose2D& pose, const DepthCamera& camera,
+                                                 std::uint64_t seed) {
+  return sensorCloud<PointT>(plan.depthImage(pose, camera, seed), pose, camera.height_above_floor);
+}
+
+/// One lidar sweep as a cloud in the sensor frame (x ahead, y left, z up),
+/// its sensor origin `lidar.height_above_floor` over the pose.
+template <typename PointT>
+typename pcl::PointCloud<PointT>::Ptr lidarCloud(const FloorPlan& plan, const Pose2D& pose, const Lidar& lidar,
+                                                 std::uint64_t seed) {
+  return sensorCloud<PointT>(plan.lidarSweep(pose, lidar, seed), pose, lidar.height_above_floor);
 }
 
 }  // namespace obsgroup::sim
