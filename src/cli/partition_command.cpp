@@ -46,18 +46,6 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-/// What reading the input gave, besides the observations.
-struct InputRecord {
-  std::string format;          ///< "carmen" or "pcd"
-  nlohmann::json parameters;   ///< reader settings actually used
-  std::vector<std::string> labels;  ///< where each observation came from, for messages
-  std::vector<std::string> warnings;
-  /// When each observation was sensed, seconds (logs and bags; empty: the
-  /// format has none), for `stream --realtime`.
-  std::vector<double> stamps;
-  double load_s = 0.0;
-};
-
 std::string detectFormat(const PartitionArgs& args) {
   namespace fs = std::filesystem;
   if (args.input == "-") {  // a log on a pipe
@@ -667,7 +655,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   return 0;
 }
 
-int runCarmen(const PartitionArgs& args) {
+AnyInput readCarmen(const PartitionArgs& args) {
   const auto start = Clock::now();
   io::CarmenOptions options;
   options.laser = args.laser;
@@ -700,7 +688,7 @@ int runCarmen(const PartitionArgs& args) {
   input.warnings = std::move(log.warnings);
   log.scans = {};  // the ranges are in the clouds now: free them for the rest of the run
   input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(observations), std::move(input));
+  return InputObservations<pcl::PointXYZ>{std::move(observations), std::move(input)};
 }
 
 /// A PCD file named by a timestamp ("1305031102.175304.pcd"): its stamp.
@@ -714,7 +702,7 @@ std::optional<double> stampOfName(const std::string& file) {
 }
 
 template <typename PointT>
-int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointKind kind, Clock::time_point start) {
+AnyInput readPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointKind kind, Clock::time_point start) {
   std::optional<std::vector<Eigen::Isometry3d>> poses;
   std::optional<io::PoseFormat> pose_format = args.pose_format;
   std::string matched = "line order";
@@ -768,10 +756,10 @@ int runPcd(const PartitionArgs& args, std::vector<std::string> files, io::PointK
   input.warnings = std::move(warnings);
   for (auto& w : sequence.warnings) input.warnings.push_back(std::move(w));
   input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(sequence.observations), std::move(input));
+  return InputObservations<PointT>{std::move(sequence.observations), std::move(input)};
 }
 
-int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
+AnyInput readDepth(const PartitionArgs& args, io::DepthLayout layout) {
   const auto start = Clock::now();
   io::DepthOptions options;
   if (args.intrinsics) options.intrinsics = io::parseIntrinsics(*args.intrinsics);
@@ -803,10 +791,10 @@ int runDepth(const PartitionArgs& args, io::DepthLayout layout) {
   recordReduction(options.reduction, sequence.reduced, input.parameters);
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(sequence.observations), std::move(input));
+  return InputObservations<pcl::PointXYZ>{std::move(sequence.observations), std::move(input)};
 }
 
-int runKitti(const PartitionArgs& args) {
+AnyInput readKitti(const PartitionArgs& args) {
   const auto start = Clock::now();
   ProgressBar bar("read", !args.quiet);
   const io::FrameReading reduction = frameReduction(args, bar);
@@ -821,11 +809,11 @@ int runKitti(const PartitionArgs& args) {
   recordReduction(reduction, sequence.reduced, input.parameters);
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(sequence.observations), std::move(input));
+  return InputObservations<pcl::PointXYZI>{std::move(sequence.observations), std::move(input)};
 }
 
 template <typename PointT>
-int runBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::FrameReading& reduction,
+AnyInput readBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::FrameReading& reduction,
              ProgressBar& bar, io::PointKind kind, Clock::time_point start) {
   io::BagSequenceOf<PointT> sequence = reader.observations<PointT>();
   bar.finish();
@@ -846,10 +834,10 @@ int runBagAs(const PartitionArgs& args, const io::BagReader& reader, const io::F
   }
   input.warnings = std::move(sequence.warnings);
   input.load_s = secondsSince(start);
-  return runPipeline(args, std::move(sequence.observations), std::move(input));
+  return InputObservations<PointT>{std::move(sequence.observations), std::move(input)};
 }
 
-int runBag(const PartitionArgs& args, io::BagVersion version) {
+AnyInput readBag(const PartitionArgs& args, io::BagVersion version) {
   const auto start = Clock::now();
   if (!io::bagSupported(version))
     throw io::InputError(args.input + ": this obsgroup was built without " +
@@ -866,14 +854,38 @@ int runBag(const PartitionArgs& args, io::BagVersion version) {
   options.reduction = frameReduction(args, bar);
   const io::BagReader reader(args.input, version, options);
   switch (const io::PointKind kind = reader.pointKind()) {
-    case io::PointKind::XYZI: return runBagAs<pcl::PointXYZI>(args, reader, options.reduction, bar, kind, start);
-    case io::PointKind::XYZRGB: return runBagAs<pcl::PointXYZRGB>(args, reader, options.reduction, bar, kind, start);
+    case io::PointKind::XYZI: return readBagAs<pcl::PointXYZI>(args, reader, options.reduction, bar, kind, start);
+    case io::PointKind::XYZRGB: return readBagAs<pcl::PointXYZRGB>(args, reader, options.reduction, bar, kind, start);
     case io::PointKind::XYZ: break;
   }
-  return runBagAs<pcl::PointXYZ>(args, reader, options.reduction, bar, io::PointKind::XYZ, start);
+  return readBagAs<pcl::PointXYZ>(args, reader, options.reduction, bar, io::PointKind::XYZ, start);
+}
+
+AnyInput readInputOfFormat(const PartitionArgs& args, const std::string& format) {
+  if (format == "carmen") return readCarmen(args);
+  if (format == "tum-rgbd") return readDepth(args, io::DepthLayout::TumRgbd);
+  if (format == "redwood") return readDepth(args, io::DepthLayout::Redwood);
+  if (format == "kitti") return readKitti(args);
+  if (format == "ros1") return readBag(args, io::BagVersion::Ros1);
+  if (format == "ros2") return readBag(args, io::BagVersion::Ros2);
+
+  const auto start = Clock::now();
+  const auto files = io::listPcdFiles(args.input);
+  switch (const io::PointKind kind = io::detectPointKind(files.front())) {
+    case io::PointKind::XYZI: return readPcd<pcl::PointXYZI>(args, files, kind, start);
+    case io::PointKind::XYZRGB: return readPcd<pcl::PointXYZRGB>(args, files, kind, start);
+    case io::PointKind::XYZ: break;
+  }
+  return readPcd<pcl::PointXYZ>(args, files, io::PointKind::XYZ, start);
 }
 
 }  // namespace
+
+AnyInput readInput(const PartitionArgs& args) {
+  const std::string format = detectFormat(args);
+  checkOptionsFit(args, format);
+  return readInputOfFormat(args, format);
+}
 
 int runPartition(const PartitionArgs& args) {
   if (args.method.threads > 0) omp_set_num_threads(args.method.threads);  // every parallel stage, the writers' too
@@ -891,21 +903,9 @@ int runPartition(const PartitionArgs& args) {
   } else {
     io::OutputFolder::check(args.output, args.force);  // fail before a long run, not after
   }
-  if (format == "carmen") return runCarmen(args);
-  if (format == "tum-rgbd") return runDepth(args, io::DepthLayout::TumRgbd);
-  if (format == "redwood") return runDepth(args, io::DepthLayout::Redwood);
-  if (format == "kitti") return runKitti(args);
-  if (format == "ros1") return runBag(args, io::BagVersion::Ros1);
-  if (format == "ros2") return runBag(args, io::BagVersion::Ros2);
-
-  const auto start = Clock::now();
-  const auto files = io::listPcdFiles(args.input);
-  switch (const io::PointKind kind = io::detectPointKind(files.front())) {
-    case io::PointKind::XYZI: return runPcd<pcl::PointXYZI>(args, files, kind, start);
-    case io::PointKind::XYZRGB: return runPcd<pcl::PointXYZRGB>(args, files, kind, start);
-    case io::PointKind::XYZ: break;
-  }
-  return runPcd<pcl::PointXYZ>(args, files, io::PointKind::XYZ, start);
+  return std::visit(
+      [&](auto&& read) { return runPipeline(args, std::move(read.observations), std::move(read.input)); },
+      readInputOfFormat(args, format));
 }
 
 }  // namespace obsgroup::cli

@@ -11,8 +11,12 @@
 #include <obsgroup/partition/keyframes.h>
 #include <obsgroup/maps/local_map_builder.h>
 
+#include <nlohmann/json.hpp>
+#include <pcl/point_types.h>
+
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace obsgroup::cli {
@@ -93,6 +97,33 @@ struct PartitionArgs {
   /// options are not used.
   std::optional<LocateOptions> locate;
 };
+
+/// What reading the input gave, besides the observations.
+struct InputRecord {
+  std::string format;          ///< "carmen", "pcd", "tum-rgbd", "redwood", "kitti", "ros1" or "ros2"
+  nlohmann::json parameters;   ///< reader settings actually used
+  std::vector<std::string> labels;  ///< where each observation came from, for messages
+  std::vector<std::string> warnings;
+  /// When each observation was sensed, seconds (logs and bags; empty: the
+  /// format has none), for `stream --realtime`.
+  std::vector<double> stamps;
+  double load_s = 0.0;
+};
+
+/// The observations of an input, in the point type its files carry.
+template <typename PointT>
+struct InputObservations {
+  std::vector<Observation<PointT>> observations;
+  InputRecord input;
+};
+using AnyInput = std::variant<InputObservations<pcl::PointXYZ>, InputObservations<pcl::PointXYZI>,
+                              InputObservations<pcl::PointXYZRGB>>;
+
+/// Reads args.input as the command does (the format detected or given, the
+/// reader options, dense frames reduced as they are read), writing nothing.
+/// Throws io::UsageError for options that do not fit the input and
+/// io::InputError for input that cannot be read.
+AnyInput readInput(const PartitionArgs& args);
 
 /// Runs the command; returns the exit code. Throws io::UsageError (exit 2),
 /// io::InputError (exit 3) and Interrupted.
