@@ -1,0 +1,91 @@
+"""The online grouping ends with the batch's groups; local maps, places and the command from Python."""
+
+import json
+
+import numpy as np
+import pytest
+
+import obsgroup
+
+
+def batch_groups(observations, **options):
+    grouping = obsgroup.Grouping(**options)
+    grouping.extend(observations)
+    return grouping.compute().groups
+
+
+def test_online_grouping_equals_the_batch_after_every_exact_update(data):
+    scans = obsgroup.read(data / "office_2d" / "office.clf")
+    online = obsgroup.OnlineGrouping()
+    created = set()
+    for k, scan in enumerate(scans):
+        assert online.insert(scan) == k
+        if (k + 1) % 20 == 0 or k + 1 == len(scans):
+            changes = online.update()
+            assert all(isinstance(c, obsgroup.Change) for c in changes)
+            created |= {c.place for c in changes if c.kind == "created"}
+            groups = sorted(online.groups.values())
+            assert groups == sorted(batch_groups(scans[: k + 1]))
+    assert set(online.groups) <= created | {c for c in online.groups}
+    assert all(online.place_of(i) in online.groups for i in range(len(scans)))
+
+
+def test_online_updates_poses_and_removals(data):
+    scans = obsgroup.read(data / "office_2d" / "office.clf")
+    online = obsgroup.OnlineGrouping()
+    for scan in scans:
+        online.insert(scan)
+    online.update()
+    online.remove(10)
+    moved = scans[20].pose.copy()
+    moved[0, 3] += 0.05
+    online.update_pose(20, moved)
+    changes = online.update()
+    assert changes, "a removal and a move change some place"
+    assert 10 not in online.ids and all(10 not in m for m in online.groups.values())
+    kept = [obsgroup.Observation(s.points, moved if i == 20 else s.pose) for i, s in enumerate(scans) if i != 10]
+    ids = [i for i in range(len(scans)) if i != 10]
+    expected = sorted([ids[k] for k in g] for g in batch_groups(kept))
+    assert sorted(online.groups.values()) == expected
+    with pytest.raises(IndexError, match="no observation 10"):
+        online.update_pose(10, np.eye(4))  # removed
+
+
+def test_local_maps_and_the_topological_map(data):
+    scans = obsgroup.read(data / "office_2d" / "office.clf")
+    grouping = obsgroup.Grouping()
+    grouping.extend(scans)
+    partition = grouping.compute()
+    maps = obsgroup.build_local_maps(scans, partition, refine="icp")
+    assert len(maps.local_maps) == len(partition)
+    for local_map, group in zip(maps.local_maps, partition.groups):
+        assert local_map.members == group
+        assert local_map.reference in group
+        assert local_map.points.shape[1] == 3 and len(local_map.points) > 100
+        assert local_map.member_poses.shape == (len(group), 4, 4)
+    assert maps.arcs and all(a["from"] < a["to"] < len(partition) for a in maps.arcs)
+    assert maps.arcs[0]["transform"].shape == (4, 4)
+    with pytest.raises(ValueError, match="refinement"):
+        obsgroup.build_local_maps(scans, partition, refine="best")
+
+
+def test_partition_runs_the_command_and_places_locate_poses(data, tmp_path):
+    log = data / "office_2d" / "office.clf"
+    result = obsgroup.partition(log, tmp_path / "out", no_pictures=True)
+    assert result["groups"] == batch_groups(obsgroup.read(log))
+    assert (tmp_path / "out" / "places.json").exists()
+    with pytest.raises(obsgroup.UsageError, match="force="):
+        obsgroup.partition(log, tmp_path / "out", no_pictures=True)
+    places = obsgroup.Places(tmp_path / "out")
+    assert len(places) == len(result["groups"]) and places.doors
+    scans = obsgroup.read(log)
+    ids = result["place_ids"]
+    located = [places.locate(s.pose).place == ids[g] for g, members in enumerate(result["groups"]) for s in
+               (scans[i] for i in members)]
+    assert sum(located) >= 0.9 * len(located)
+    assert places.locate((1000.0, 1000.0)).place is None
+
+
+def test_a_folder_without_places_is_an_input_error(tmp_path):
+    with pytest.raises(ValueError):
+        obsgroup.Places(tmp_path)
