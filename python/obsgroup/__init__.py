@@ -408,13 +408,15 @@ class Places:
 # --- the command -----------------------------------------------------------------------------------
 
 def partition(input: Union[str, os.PathLike], output_dir: Union[str, os.PathLike], *, quiet: bool = True,
-              **options: Any) -> Dict[str, Any]:
+              progress: Optional[ProgressCallback] = None, **options: Any) -> Dict[str, Any]:
     """Does what ``obsgroup partition INPUT -o OUTPUT_DIR`` does (any of its options as keyword
     arguments: ``refine="lum"``, ``no_pictures=True``, ``keyframes=(0.1, 10)``, ``force=True``,
-    ...) and returns the parsed ``partition.json``."""
+    ...) and returns the parsed ``partition.json``. ``quiet=False`` prints the command's progress
+    bar, warnings and summary on stderr; ``progress(stage, done, total)`` follows every stage
+    (read, overlap, local maps, places, pictures)."""
     options["quiet"] = quiet
     words = ["partition", os.fspath(input), "-o", os.fspath(output_dir)] + _words(
         options, _COMMAND_OPTIONS, "partition")
-    _call(_obsgroup._run_command, words)
+    _call(_obsgroup._run_command, words, progress)
     with open(os.path.join(os.fspath(output_dir), "partition.json"), encoding="utf-8") as f:
         return json.load(f)

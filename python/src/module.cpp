@@ -92,14 +92,27 @@ cli::PartitionArgs parseArgs(const std::vector<std::string>& words) {
 // --- long calls: GIL released, Ctrl-C and progress polled ---
 
 /// Progress reported by the worker, relayed to Python by the caller's thread.
+/// Steps of one stage between two polls fold into the latest, but every stage
+/// is relayed, in order, with its last step.
 struct Progress {
+  struct Step {
+    std::string stage;
+    std::size_t done, total;
+  };
   std::mutex mutex;
-  std::string stage;
-  std::size_t done = 0, total = 0;
-  bool changed = false;
-  void set(const std::string& s, std::size_t d, std::size_t t) {
+  std::vector<Step> pending;
+  void set(const std::string& stage, std::size_t done, std::size_t total) {
     std::lock_guard<std::mutex> lock(mutex);
-    stage = s, done = d, total = t, changed = true;
+    if (!pending.empty() && pending.back().stage == stage)
+      pending.back() = {stage, done, total};
+    else
+      pending.push_back({stage, done, total});
+  }
+  std::vector<Step> take() {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<Step> steps;
+    steps.swap(pending);
+    return steps;
   }
 };
 
@@ -122,16 +135,8 @@ auto runReleased(Work work, InterruptFlag& flag, Progress* progress, const py::o
       status = future.wait_for(std::chrono::milliseconds(20));
     }
     if (!python_error && progress && !callback.is_none()) {
-      std::string stage;
-      std::size_t done = 0, total = 0;
-      bool changed = false;
-      {
-        std::lock_guard<std::mutex> lock(progress->mutex);
-        std::swap(changed, progress->changed);
-        stage = progress->stage, done = progress->done, total = progress->total;
-      }
       try {
-        if (changed) callback(stage, done, total);
+        for (const Progress::Step& step : progress->take()) callback(step.stage, step.done, step.total);
       } catch (py::error_already_set& e) {  // the callback raised: stop the work, raise it
         python_error.emplace(std::move(e));
         flag.store(true);
@@ -291,7 +296,11 @@ py::tuple readInput(const std::vector<std::string>& words, const py::object& cal
   cli::PartitionArgs args = parseArgs(words);
   InterruptFlag flag{false};
   args.interrupt = &flag;
-  cli::AnyInput input = runReleased([&args] { return cli::readInput(args); }, flag, nullptr, callback);
+  Progress progress;
+  args.progress = [&progress](const std::string& stage, std::size_t done, std::size_t total) {
+    progress.set(stage, done, total);
+  };
+  cli::AnyInput input = runReleased([&args] { return cli::readInput(args); }, flag, &progress, callback);
   std::vector<std::string> warnings;
   std::string format, parameters;
   py::list observations = observationsOf(std::move(input), warnings, format, parameters);
@@ -450,7 +459,7 @@ py::tuple locate(const PlaceMap& places, double x, double y, double tolerance) {
 
 // --- the command ---
 
-int runCommand(const std::vector<std::string>& words) {
+int runCommand(const std::vector<std::string>& words, const py::object& callback) {
   const std::vector<const char*> argv = argvOf(words);
   const cli::ParsedCommandLine parsed = cli::parseCommandLine(int(argv.size()), argv.data());
   if (!parsed.args) {
@@ -460,7 +469,11 @@ int runCommand(const std::vector<std::string>& words) {
   cli::PartitionArgs args = *parsed.args;
   InterruptFlag flag{false};
   args.interrupt = &flag;
-  return runReleased([&args] { return cli::runPartition(args); }, flag, nullptr, py::none());
+  Progress progress;
+  args.progress = [&progress](const std::string& stage, std::size_t done, std::size_t total) {
+    progress.set(stage, done, total);
+  };
+  return runReleased([&args] { return cli::runPartition(args); }, flag, &progress, callback);
 }
 
 }  // namespace
@@ -527,7 +540,7 @@ PYBIND11_MODULE(_obsgroup, m) {
       .def("__len__", &PyObservation::size);
 
   m.def("_read", &readInput, py::arg("words"), py::arg("progress") = py::none());
-  m.def("_run_command", &runCommand, py::arg("words"));
+  m.def("_run_command", &runCommand, py::arg("words"), py::arg("progress") = py::none());
 
   py::class_<PyPartition>(m, "_Partition")
       .def_property_readonly("groups", [](const PyPartition& p) { return p.partition.groups; })

@@ -89,3 +89,17 @@ def test_partition_runs_the_command_and_places_locate_poses(data, tmp_path):
 def test_a_folder_without_places_is_an_input_error(tmp_path):
     with pytest.raises(ValueError):
         obsgroup.Places(tmp_path)
+
+
+def test_partition_reports_the_progress_of_every_stage(data, tmp_path):
+    steps = []
+    obsgroup.partition(data / "office_3d" / "pcd", tmp_path / "out", poses=data / "office_3d" / "poses.txt",
+                       progress=lambda stage, done, total: steps.append((stage, done, total)))
+    stages = []
+    for stage, done, total in steps:
+        assert 0 <= done <= total
+        if not stages or stages[-1] != stage:
+            stages.append(stage)
+    assert stages == ["read", "overlap", "local maps", "places", "pictures"]
+    last = {stage: (done, total) for stage, done, total in steps}
+    assert all(done == total for done, total in last.values())  # each stage ends complete

@@ -166,7 +166,7 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
                        const InputRecord& input, GroupingOutcome<PointT>& out) {
   ObservationGrouping<PointT>& grouping = out.grouping;
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-  ProgressBar bar("overlap", !args.quiet);
+  ProgressBar bar("overlap", !args.quiet, args.progress);
   grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   try {
     out.partition = grouping.compute();
@@ -222,7 +222,7 @@ MapsOfRun<PointT> buildMaps(const PartitionArgs& args, const std::vector<Observa
   builder.setVoxelLeafSize(run.voxel);
   builder.setNumberOfThreads(args.method.threads);
   builder.setInterruptFlag(args.interrupt);
-  ProgressBar bar("local maps", !args.quiet);
+  ProgressBar bar("local maps", !args.quiet, args.progress);
   builder.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   run.maps = builder.build(observations, partition, W);
   bar.finish();
@@ -260,7 +260,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
   const bool planar = isPlanarData(world, sensorOrigins(observations, world), args.method.regions.cell_size);
   const render::HeightBand band{args.method.regions.band_low, args.method.regions.band_high};
   const render::HeightBand* slice = planar ? nullptr : &band;
-  ProgressBar bar("pictures", !args.quiet);
+  ProgressBar bar("pictures", !args.quiet, args.progress);
   bar(0, 4);
   render::writeMapPictures(staged, world, posesOf(observations),
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
@@ -350,7 +350,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
   const auto places_start = Clock::now();
-  ProgressBar bar("places", !args.quiet);
+  ProgressBar bar("places", !args.quiet, args.progress);
   bar(0, 2);
   // The grouping's own regions when it kept them (partition); computed here otherwise (stream, points model).
   const ObservationRegions& kept = grouped.grouping.getRegions();
@@ -741,7 +741,7 @@ AnyInput readPcd(const PartitionArgs& args, std::vector<std::string> files, io::
       poses = io::parsePoses(bytes, name, *pose_format);
     }
   }
-  ProgressBar bar("read", !args.quiet);
+  ProgressBar bar("read", !args.quiet, args.progress);
   const io::FrameReading reduction = frameReduction(args, bar);
   io::PcdSequence<PointT> sequence = io::loadPcdSequence<PointT>(files, poses, args.poses.value_or(""), reduction);
   bar.finish();
@@ -769,7 +769,7 @@ AnyInput readDepth(const PartitionArgs& args, io::DepthLayout layout) {
   options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
   options.poses = args.poses;
   options.up = args.up;
-  ProgressBar bar("read", !args.quiet);
+  ProgressBar bar("read", !args.quiet, args.progress);
   options.reduction = frameReduction(args, bar);
   io::DepthSequence sequence = io::loadDepthSequence(args.input, layout, options);
   bar.finish();
@@ -796,7 +796,7 @@ AnyInput readDepth(const PartitionArgs& args, io::DepthLayout layout) {
 
 AnyInput readKitti(const PartitionArgs& args) {
   const auto start = Clock::now();
-  ProgressBar bar("read", !args.quiet);
+  ProgressBar bar("read", !args.quiet, args.progress);
   const io::FrameReading reduction = frameReduction(args, bar);
   io::KittiSequence sequence = io::loadKittiSequence(args.input, args.poses, reduction);
   bar.finish();
@@ -850,7 +850,7 @@ AnyInput readBag(const PartitionArgs& args, io::BagVersion version) {
   options.fixed_frame = args.fixed_frame;
   options.poses_file = args.poses;
   options.max_time_difference = args.max_time_difference.value_or(io::kDefaultMaxTimeDifference);
-  ProgressBar bar("convert", !args.quiet);
+  ProgressBar bar("convert", !args.quiet, args.progress);
   options.reduction = frameReduction(args, bar);
   const io::BagReader reader(args.input, version, options);
   switch (const io::PointKind kind = reader.pointKind()) {

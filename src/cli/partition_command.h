@@ -10,6 +10,7 @@
 #include <obsgroup/grouping_parameters.h>
 #include <obsgroup/partition/keyframes.h>
 #include <obsgroup/maps/local_map_builder.h>
+#include "progress_bar.h"
 
 #include <nlohmann/json.hpp>
 #include <pcl/point_types.h>
@@ -91,6 +92,9 @@ struct PartitionArgs {
   /// Set (by a SIGINT/SIGTERM handler) to stop the run; the output folder is
   /// then left as it was.
   const InterruptFlag* interrupt = nullptr;
+  /// Told each step of each stage (the progress bars' steps), from the
+  /// thread doing the work.
+  ProgressObserver progress;
   /// Set: `obsgroup stream` (the online grouping), not `partition`.
   std::optional<StreamOptions> stream;
   /// Set: `obsgroup locate`: `output` is the JSON file written, the method's

@@ -6,16 +6,23 @@
 
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <string>
 
 namespace obsgroup::cli {
 
+/// Told every step of every stage ("read", "overlap", ...), whether or not a
+/// bar is drawn: how a program running the command follows it.
+using ProgressObserver = std::function<void(const std::string& stage, std::size_t done, std::size_t total)>;
+
 class ProgressBar {
  public:
-  ProgressBar(std::string label, bool enabled) : label_(std::move(label)), enabled_(enabled && ::isatty(2)) {}
+  ProgressBar(std::string label, bool enabled, ProgressObserver observer = {})
+      : label_(std::move(label)), enabled_(enabled && ::isatty(2)), observer_(std::move(observer)) {}
   ~ProgressBar() { finish(); }
 
   void operator()(std::size_t done, std::size_t total) {
+    if (observer_) observer_(label_, done, total);
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
     if (done < total && now - last_ < std::chrono::milliseconds(100)) return;
@@ -39,6 +46,7 @@ class ProgressBar {
  private:
   std::string label_;
   bool enabled_;
+  ProgressObserver observer_;
   bool shown_ = false;
   std::chrono::steady_clock::time_point last_{};
 };
