@@ -1002,3 +1002,25 @@ TEST(FrameReading, AMessageCloudIsReducedToTheSameVoxelsKeepingItsFields) {
   no_z.fields.pop_back();
   EXPECT_FALSE(reduceFrame(no_z, FrameReading{0.1, 0, {}}));
 }
+
+TEST(Readers, BeamDirectionsGiveScanToCloudsPointsBitForBit) {
+  const CarmenLog log = readCarmenLog(std::string(OBSGROUP_DATA_DIR) + "/real/sena_odometry/sena_odometry.clf");
+  const BeamDirections beams(log.scans.front());
+  for (const LaserScan& scan : log.scans) {
+    const auto expected = scanToCloud(scan);
+    const auto cloud = beams.cloudOf(scan);
+    ASSERT_EQ(cloud->size(), expected->size());
+    ASSERT_EQ(cloud->width, expected->width);
+    for (std::size_t i = 0; i < cloud->size(); ++i) {
+      ASSERT_EQ((*cloud)[i].x, (*expected)[i].x);
+      ASSERT_EQ((*cloud)[i].y, (*expected)[i].y);
+      ASSERT_EQ((*cloud)[i].z, 0.0f);
+    }
+  }
+  // A scan of another geometry: computed on its own, not from the table.
+  const CarmenLog turn = parseCarmenLog(robotLaser(-kPi, 2 * kPi, 2 * kPi / 360, 360, 5.0), "turn.clf");
+  const auto other = beams.cloudOf(turn.scans[0]);
+  const auto expected = scanToCloud(turn.scans[0]);
+  ASSERT_EQ(other->size(), expected->size());
+  for (std::size_t i = 0; i < other->size(); ++i) EXPECT_EQ((*other)[i].x, (*expected)[i].x);
+}

@@ -13,7 +13,8 @@ The method of Blanco, Gonzalez and Fernandez-Madrigal (ICRA 2006) as the C++ lib
 Options are the command's, as keyword arguments with ``_`` for ``-`` (``ncut_threshold=0.8`` is
 ``--ncut-threshold 0.8``; ``model=`` is ``--sso``): the same defaults, the same checks, the same
 messages. Bad input raises :class:`InputError`, a bad option :class:`UsageError` (both
-``ValueError``). Long calls release the GIL and stop on Ctrl-C with ``KeyboardInterrupt``.
+``ValueError``). Long calls release the GIL and stop on Ctrl-C with ``KeyboardInterrupt``
+(when made from the main thread, where Python handles signals).
 """
 
 from __future__ import annotations
@@ -40,7 +41,8 @@ __all__ = [
 ]
 
 ProgressCallback = Callable[[str, int, int], Any]
-"""Called as ``progress(stage, done, total)`` from the thread that made the call."""
+"""Called as ``progress(stage, done, total)``, one call at a time, from whichever thread is doing the
+work (with the GIL); if it raises, the work stops and the call raises its exception."""
 
 PoseLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
 """A 4x4 homogeneous matrix, a 3x3 planar one, or ``(x, y, theta)`` (radians)."""
@@ -257,8 +259,8 @@ class Grouping:
             self.add(observation)
 
     def compute(self, progress: Optional[ProgressCallback] = None) -> Partition:
-        """Computes the overlap, W and the partition. ``progress(stage, done, total)`` is called
-        from this thread as the overlap advances. Ctrl-C raises ``KeyboardInterrupt``."""
+        """Computes the overlap, W and the partition. ``progress(stage, done, total)`` follows the
+        overlap stage. Ctrl-C raises ``KeyboardInterrupt``; the grouping stays usable."""
         result = Partition(_call(self._native.compute, progress))
         _warn(result.warnings)
         return result

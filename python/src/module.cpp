@@ -2,8 +2,8 @@
 // Options arrive as the command's own arguments (the Python layer turns
 // keyword arguments into them), so defaults, checks and messages are the
 // command's. Points cross as numpy views of the PCL clouds where the layout
-// allows, and every long call releases the GIL, polls for Ctrl-C and relays
-// progress from the calling thread.
+// allows; every long call runs with the GIL released, stops on Ctrl-C and
+// hands progress to a Python callback one step at a time.
 
 #include "command_line.h"
 #include "partition_command.h"
@@ -27,13 +27,14 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <signal.h>
+
 #include <atomic>
+#include <functional>
 #include <chrono>
-#include <future>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <variant>
 #include <vector>
 
@@ -91,69 +92,116 @@ cli::PartitionArgs parseArgs(const std::vector<std::string>& words) {
 
 // --- long calls: GIL released, Ctrl-C and progress polled ---
 
-/// Progress reported by the worker, relayed to Python by the caller's thread.
-/// Steps of one stage between two polls fold into the latest, but every stage
-/// is relayed, in order, with its last step.
-struct Progress {
-  struct Step {
-    std::string stage;
-    std::size_t done, total;
-  };
-  std::mutex mutex;
-  std::vector<Step> pending;
-  void set(const std::string& stage, std::size_t done, std::size_t total) {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (!pending.empty() && pending.back().stage == stage)
-      pending.back() = {stage, done, total};
-    else
-      pending.push_back({stage, done, total});
+/// Progress for a Python callback. The steps come from the threads doing the
+/// work; each is handed to the callback with the GIL, one at a time. If the
+/// callback raises, the work is stopped (its interrupt flag) and the error kept
+/// for the caller to raise.
+class ProgressRelay {
+ public:
+  ProgressRelay(py::object callback, InterruptFlag& flag) : callback_(std::move(callback)), flag_(flag) {}
+  ~ProgressRelay() {
+    py::gil_scoped_acquire gil;  // the callback and a kept error are Python objects
+    callback_ = py::none();
+    error_.reset();
   }
-  std::vector<Step> take() {
-    std::lock_guard<std::mutex> lock(mutex);
-    std::vector<Step> steps;
-    steps.swap(pending);
-    return steps;
+  void operator()(const std::string& stage, std::size_t done, std::size_t total) {
+    if (callback_.is_none() || failed_.load()) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (failed_.load()) return;
+    py::gil_scoped_acquire gil;
+    try {
+      callback_(stage, done, total);
+    } catch (py::error_already_set& e) {
+      error_.emplace(std::move(e));
+      failed_.store(true);
+      flag_.store(true);
+    }
   }
+  /// The callback's error, if it raised (with the GIL).
+  void rethrow() {
+    if (error_) {
+      py::error_already_set error = std::move(*error_);
+      error_.reset();
+      throw error;
+    }
+  }
+
+ private:
+  py::object callback_;
+  InterruptFlag& flag_;
+  std::mutex mutex_;
+  std::atomic<bool> failed_{false};
+  std::optional<py::error_already_set> error_;
 };
 
-/// Runs `work` on a worker thread while this thread, without the GIL, waits
-/// for it; every 20 ms it takes the GIL to call the progress callback and to
-/// see a pending Ctrl-C, which sets `flag` (the work polls it and throws
-/// Interrupted) and is raised as KeyboardInterrupt once the worker stopped.
+/// While a long call runs, SIGINT (Ctrl-C) sets the call's interrupt flag, so
+/// that the work stops at its next poll, then goes on to Python's own handler,
+/// which raises KeyboardInterrupt when the call returns. Installed only on
+/// Python's main thread (where its handlers run) and only over a handler
+/// Python installed, so a program that ignores SIGINT or leaves it to the
+/// system keeps its choice.
+class SigintToFlag {
+ public:
+  explicit SigintToFlag(InterruptFlag& flag) {
+    if (PyThread_get_thread_ident() != mainThread()) return;
+    struct sigaction current {};
+    if (sigaction(SIGINT, nullptr, &current) != 0 || (current.sa_flags & SA_SIGINFO) ||
+        current.sa_handler == SIG_DFL || current.sa_handler == SIG_IGN || current.sa_handler == &onSignal)
+      return;
+    previous_ = current;
+    flag_.store(&flag);
+    struct sigaction action {};
+    action.sa_handler = &onSignal;
+    sigemptyset(&action.sa_mask);
+    installed_ = sigaction(SIGINT, &action, nullptr) == 0;
+  }
+  ~SigintToFlag() {
+    if (!installed_) return;
+    sigaction(SIGINT, &previous_, nullptr);
+    flag_.store(nullptr);
+  }
+  SigintToFlag(const SigintToFlag&) = delete;
+  SigintToFlag& operator=(const SigintToFlag&) = delete;
+
+ private:
+  static unsigned long mainThread() {
+    static const unsigned long ident = py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+    return ident;
+  }
+  static void onSignal(int signal) {
+    if (InterruptFlag* flag = flag_.load()) flag->store(true);
+    if (previous_.sa_handler != SIG_DFL && previous_.sa_handler != SIG_IGN) previous_.sa_handler(signal);
+  }
+  static inline std::atomic<InterruptFlag*> flag_{nullptr};
+  static inline struct sigaction previous_ {};
+  bool installed_ = false;
+};
+
+/// Runs `work` on this thread with the GIL released (the readers and the
+/// grouping keep their own threads busy; the caller's other Python threads
+/// run meanwhile). Ctrl-C stops it through `flag` and raises KeyboardInterrupt;
+/// an error of the progress callback stops it and is raised.
 template <typename Work>
-auto runReleased(Work work, InterruptFlag& flag, Progress* progress, const py::object& callback) {
+auto runReleased(Work work, InterruptFlag& flag, ProgressRelay* progress = nullptr) {
   using Result = decltype(work());
   flag.store(false);
-  std::packaged_task<Result()> task(std::move(work));
-  std::future<Result> future = task.get_future();
-  std::thread worker(std::move(task));
-  std::optional<py::error_already_set> python_error;
-  for (;;) {
-    std::future_status status;
-    {
-      py::gil_scoped_release release;
-      status = future.wait_for(std::chrono::milliseconds(20));
-    }
-    if (!python_error && progress && !callback.is_none()) {
-      try {
-        for (const Progress::Step& step : progress->take()) callback(step.stage, step.done, step.total);
-      } catch (py::error_already_set& e) {  // the callback raised: stop the work, raise it
-        python_error.emplace(std::move(e));
-        flag.store(true);
-      }
-    }
-    if (status == std::future_status::ready) break;
-    if (!python_error && PyErr_CheckSignals() != 0) {
-      python_error.emplace();  // KeyboardInterrupt (or what the handler raised)
-      flag.store(true);
-    }
-  }
+  std::optional<Result> result;
+  std::exception_ptr failure;
   {
+    SigintToFlag sigint(flag);
     py::gil_scoped_release release;
-    worker.join();
+    try {
+      result.emplace(work());
+    } catch (...) {
+      failure = std::current_exception();
+    }
   }
-  if (python_error) throw std::move(*python_error);
-  return future.get();
+  if (progress) progress->rethrow();
+  // Ctrl-C: Python's handler raises KeyboardInterrupt now (or what a handler of the program's raises);
+  // should none raise, the work's Interrupted is translated to KeyboardInterrupt.
+  if (flag.load() && PyErr_CheckSignals() != 0) throw py::error_already_set();
+  if (failure) std::rethrow_exception(failure);
+  return std::move(*result);
 }
 
 // --- numpy ---
@@ -296,11 +344,9 @@ py::tuple readInput(const std::vector<std::string>& words, const py::object& cal
   cli::PartitionArgs args = parseArgs(words);
   InterruptFlag flag{false};
   args.interrupt = &flag;
-  Progress progress;
-  args.progress = [&progress](const std::string& stage, std::size_t done, std::size_t total) {
-    progress.set(stage, done, total);
-  };
-  cli::AnyInput input = runReleased([&args] { return cli::readInput(args); }, flag, &progress, callback);
+  ProgressRelay progress(callback, flag);
+  args.progress = std::ref(progress);
+  cli::AnyInput input = runReleased([&args] { return cli::readInput(args); }, flag, &progress);
   std::vector<std::string> warnings;
   std::string format, parameters;
   py::list observations = observationsOf(std::move(input), warnings, format, parameters);
@@ -327,23 +373,16 @@ class PyGrouping {
   std::size_t size() const { return grouping_.getObservations().size(); }
 
   PyPartition compute(const py::object& callback) {
-    Progress progress;
-    grouping_.setProgressCallback([&progress](std::size_t done, std::size_t total) {
-      progress.set("overlap", done, total);
-    });
+    ProgressRelay progress(callback, interrupt_);
+    grouping_.setProgressCallback([&progress](std::size_t done, std::size_t total) { progress("overlap", done, total); });
     PyPartition result;
-    result.partition = runReleased([this] { return grouping_.compute(); }, interrupt_, &progress, callback);
+    result.partition = runReleased([this] { return grouping_.compute(); }, interrupt_, &progress);
     grouping_.setProgressCallback({});
     result.W = grouping_.getWeightMatrix();
     result.warnings = grouping_.getWarnings();
     return result;
   }
   const GroupingParameters& parameters() const { return grouping_.getParameters(); }
-  std::vector<PyObservation> observations() const {
-    std::vector<PyObservation> out;
-    for (const auto& o : grouping_.getObservations()) out.push_back({AnyCloud(o.cloud), o.pose, std::nullopt, ""});
-    return out;
-  }
   py::dict timings() const {
     const GroupingTimings& t = grouping_.getTimings();
     py::dict d;
@@ -377,7 +416,7 @@ class PyOnlineGrouping {
   void remove(int id) { online_.remove(id); }
   py::dict update(bool exact) {
     const GroupUpdate update = runReleased([this, exact] { return exact ? online_.updateExact() : online_.update(); },
-                                           interrupt_, nullptr, py::none());
+                                           interrupt_);
     py::list changes;
     for (const GroupChange& c : update.changes) changes.append(changeOf(c));
     py::dict d;
@@ -420,12 +459,10 @@ py::tuple buildLocalMaps(const std::vector<PyObservation>& observations, const P
   builder.setNumberOfThreads(threads);
   InterruptFlag flag{false};
   builder.setInterruptFlag(&flag);
-  Progress progress;
-  builder.setProgressCallback([&progress](std::size_t done, std::size_t total) {
-    progress.set("local maps", done, total);
-  });
-  std::vector<LocalMap<pcl::PointXYZ>> maps = runReleased(
-      [&] { return builder.build(clouds, partition.partition, partition.W); }, flag, &progress, callback);
+  ProgressRelay progress(callback, flag);
+  builder.setProgressCallback([&progress](std::size_t done, std::size_t total) { progress("local maps", done, total); });
+  std::vector<LocalMap<pcl::PointXYZ>> maps =
+      runReleased([&] { return builder.build(clouds, partition.partition, partition.W); }, flag, &progress);
   std::vector<LocalMapFrame> frames;
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& m : maps) frames.push_back(m.frame);
@@ -469,11 +506,9 @@ int runCommand(const std::vector<std::string>& words, const py::object& callback
   cli::PartitionArgs args = *parsed.args;
   InterruptFlag flag{false};
   args.interrupt = &flag;
-  Progress progress;
-  args.progress = [&progress](const std::string& stage, std::size_t done, std::size_t total) {
-    progress.set(stage, done, total);
-  };
-  return runReleased([&args] { return cli::runPartition(args); }, flag, &progress, callback);
+  ProgressRelay progress(callback, flag);
+  args.progress = std::ref(progress);
+  return runReleased([&args] { return cli::runPartition(args); }, flag, &progress);
 }
 
 }  // namespace
@@ -555,7 +590,6 @@ PYBIND11_MODULE(_obsgroup, m) {
       .def("add_points", &PyGrouping::addPoints)
       .def("__len__", &PyGrouping::size)
       .def("compute", &PyGrouping::compute, py::arg("progress") = py::none())
-      .def("observations", &PyGrouping::observations)
       .def("timings", &PyGrouping::timings)
       .def("parameters", [](const PyGrouping& g) {
         const GroupingParameters& p = g.parameters();

@@ -668,13 +668,14 @@ AnyInput readCarmen(const PartitionArgs& args) {
   const std::string name = io::inputName(args.input);
   const int n = static_cast<int>(log.scans.size());
   std::vector<Observation<pcl::PointXYZ>> observations(n);
+  const io::BeamDirections beams(log.scans.empty() ? io::LaserScan{} : log.scans.front());  // the trigonometry once
   InputRecord input;
   input.format = "carmen";
   input.labels.resize(n);
   input.stamps.resize(n);
 #pragma omp parallel for schedule(dynamic, 64)
   for (int i = 0; i < n; ++i) {
-    observations[i] = {io::scanToCloud(log.scans[i]), log.scans[i].laser_pose};
+    observations[i] = {beams.cloudOf(log.scans[i]), log.scans[i].laser_pose};
     input.labels[i] = name + ":" + std::to_string(log.scans[i].line);
     input.stamps[i] = log.scans[i].timestamp;
   }

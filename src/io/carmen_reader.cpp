@@ -489,14 +489,45 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
   return parseText(content, path, options);
 }
 
+namespace {
+double beamAngle(const LaserScan& scan, std::size_t k) { return scan.start_angle + k * scan.angle_step; }
+}  // namespace
+
 pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->reserve(scan.ranges.size());
   for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
     const double r = scan.ranges[k];
     if (!isReturn(r, scan.max_range)) continue;
-    const double angle = scan.start_angle + k * scan.angle_step;
+    const double angle = beamAngle(scan, k);
     cloud->push_back(pcl::PointXYZ(float(r * std::cos(angle)), float(r * std::sin(angle)), 0.0f));
+  }
+  return cloud;
+}
+
+BeamDirections::BeamDirections(const LaserScan& scan)
+    : start_angle_(scan.start_angle), angle_step_(scan.angle_step) {
+  cos_.reserve(scan.ranges.size());
+  sin_.reserve(scan.ranges.size());
+  for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
+    const double angle = beamAngle(scan, k);
+    cos_.push_back(std::cos(angle));
+    sin_.push_back(std::sin(angle));
+  }
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr BeamDirections::cloudOf(const LaserScan& scan) const {
+  if (scan.start_angle != start_angle_ || scan.angle_step != angle_step_ || scan.ranges.size() != cos_.size())
+    return scanToCloud(scan);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  std::size_t returns = 0;
+  for (double r : scan.ranges) returns += isReturn(r, scan.max_range);
+  cloud->resize(returns);
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < scan.ranges.size(); ++k) {
+    const double r = scan.ranges[k];
+    if (!isReturn(r, scan.max_range)) continue;
+    (*cloud)[n++] = pcl::PointXYZ(float(r * cos_[k]), float(r * sin_[k]), 0.0f);
   }
   return cloud;
 }

@@ -92,4 +92,18 @@ CarmenLog parseCarmenLog(std::string_view content, const std::string& path, cons
 /// readings and readings at or beyond max_range give no point.
 pcl::PointCloud<pcl::PointXYZ>::Ptr scanToCloud(const LaserScan& scan);
 
+/// cos and sin of every beam's angle for scans of one geometry (start angle,
+/// step and beam count): the trigonometry of scanToCloud done once for a log
+/// whose scans share it, as most do. The points are the same bit for bit.
+class BeamDirections {
+ public:
+  explicit BeamDirections(const LaserScan& scan);
+  /// The scan's cloud, from the table when its geometry is the table's.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloudOf(const LaserScan& scan) const;
+
+ private:
+  double start_angle_, angle_step_;
+  std::vector<double> cos_, sin_;
+};
+
 }  // namespace obsgroup::io
