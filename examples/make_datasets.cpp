@@ -230,8 +230,15 @@ int main(int argc, char** argv) {
   if (argc == 3 && std::string(argv[1]) == "--ros2-bag")
     return writeOffice2D(obsgroup::test::Ros2BagWriter(argv[2]), argv[2]);
 #endif
-  if (argc < 2 || argc > 3 || (argc == 3 && std::string(argv[2]) != "--force")) {
-    std::cerr << "usage: " << argv[0] << " OUTDIR [--force] | --tum-rgbd FOLDER | --ros1-bag FILE | --ros2-bag FOLDER\n";
+  const std::string usage =
+      "usage: " + std::string(argv[0]) + " OUTDIR [--force] | --tum-rgbd FOLDER | --ros1-bag FILE | --ros2-bag FOLDER\n";
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::cout << usage;
+    return 0;
+  }
+  // An option where OUTDIR belongs is a mistake (or a bag kind this build lacks), not a folder name.
+  if (argc < 2 || argc > 3 || argv[1][0] == '-' || (argc == 3 && std::string(argv[2]) != "--force")) {
+    std::cerr << usage;
     return 2;
   }
   const fs::path out = argv[1];

@@ -102,3 +102,30 @@ def test_a_users_observation_from_numpy(data):
     observation = obsgroup.Observation(points, np.eye(4), stamp=2.5, source="mine")
     assert np.allclose(observation.points, points.astype(np.float32))
     assert observation.stamp == 2.5 and observation.source == "mine" and len(observation) == 100
+
+
+def make_datasets():
+    """The generator of the shipped data (ctest and CI set OBSGROUP_MAKE_DATASETS): it writes bags."""
+    import os
+
+    return os.environ.get("OBSGROUP_MAKE_DATASETS")
+
+
+@pytest.mark.skipif(not make_datasets(), reason="needs examples/make_datasets (OBSGROUP_MAKE_DATASETS)")
+@pytest.mark.parametrize("kind", ["ros1", "ros2"])
+def test_a_ros_bag_reads_and_groups_as_the_command_reads_it(data, tmp_path, kind):
+    import subprocess
+    from conftest import run_command
+
+    bag = tmp_path / ("office.bag" if kind == "ros1" else "office_ros2")
+    made = subprocess.run([make_datasets(), f"--{kind}-bag", str(bag)], capture_output=True, text=True)
+    if made.returncode != 0:
+        pytest.skip(f"this build writes no {kind} bags: {made.stderr.strip()}")
+    scans = obsgroup.read(bag, topic="scan")  # the command's topic matching: /scan
+    assert scans.format == kind and len(scans) == 77
+    assert all(s.stamp is not None and "/scan" in s.source for s in scans)
+    log = obsgroup.read(data / "office_2d" / "office.clf")
+    assert all(np.allclose(a.points, b.points, atol=1e-4) for a, b in zip(scans, log))
+    grouping = obsgroup.Grouping()
+    grouping.extend(scans)
+    assert grouping.compute().groups == run_command(bag, tmp_path / "out", "--topic", "scan")["groups"]
