@@ -355,6 +355,19 @@ py::tuple readInput(const std::vector<std::string>& words, const py::object& cal
 
 // --- batch grouping ---
 
+/// Held while an object computes with the GIL released: another Python
+/// thread that calls into the same object meanwhile gets an error, not a race.
+class BusyGuard {
+ public:
+  BusyGuard(std::mutex& mutex, const char* what) : lock_(mutex, std::try_to_lock) {
+    if (!lock_.owns_lock())
+      throw std::runtime_error(std::string(what) + " is busy in another thread; use one object per thread");
+  }
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
 class PyGrouping {
  public:
   explicit PyGrouping(const std::vector<std::string>& words) : args_(parseArgs(words)) {
@@ -362,17 +375,20 @@ class PyGrouping {
     grouping_.setInterruptFlag(&interrupt_);
   }
   int add(const PyObservation& observation) {
+    BusyGuard busy(busy_, "the Grouping");
     grouping_.addObservation(observation.xyz(), observation.pose);
     return int(grouping_.getObservations().size()) - 1;
   }
   int addPoints(const py::array_t<float, py::array::c_style | py::array::forcecast>& points,
                 const Eigen::Matrix4d& pose) {
+    BusyGuard busy(busy_, "the Grouping");
     grouping_.addObservation(cloudOf(points), isometryOf(pose));
     return int(grouping_.getObservations().size()) - 1;
   }
   std::size_t size() const { return grouping_.getObservations().size(); }
 
   PyPartition compute(const py::object& callback) {
+    BusyGuard busy(busy_, "the Grouping");
     ProgressRelay progress(callback, interrupt_);
     grouping_.setProgressCallback([&progress](std::size_t done, std::size_t total) { progress("overlap", done, total); });
     PyPartition result;
@@ -395,6 +411,7 @@ class PyGrouping {
  private:
   cli::PartitionArgs args_;
   InterruptFlag interrupt_{false};
+  std::mutex busy_;
   ObservationGrouping<pcl::PointXYZ> grouping_;
 };
 
@@ -407,14 +424,25 @@ class PyOnlineGrouping {
     online_.setExactInterval(exact_every);
     online_.setInterruptFlag(&interrupt_);
   }
-  int insert(const PyObservation& observation) { return online_.insert(observation.xyz(), observation.pose); }
+  int insert(const PyObservation& observation) {
+    BusyGuard busy(busy_, "the OnlineGrouping");
+    return online_.insert(observation.xyz(), observation.pose);
+  }
   int insertPoints(const py::array_t<float, py::array::c_style | py::array::forcecast>& points,
                    const Eigen::Matrix4d& pose) {
+    BusyGuard busy(busy_, "the OnlineGrouping");
     return online_.insert(cloudOf(points), isometryOf(pose));
   }
-  void updatePose(int id, const Eigen::Matrix4d& pose) { online_.updatePose(id, isometryOf(pose)); }
-  void remove(int id) { online_.remove(id); }
+  void updatePose(int id, const Eigen::Matrix4d& pose) {
+    BusyGuard busy(busy_, "the OnlineGrouping");
+    online_.updatePose(id, isometryOf(pose));
+  }
+  void remove(int id) {
+    BusyGuard busy(busy_, "the OnlineGrouping");
+    online_.remove(id);
+  }
   py::dict update(bool exact) {
+    BusyGuard busy(busy_, "the OnlineGrouping");
     const GroupUpdate update = runReleased([this, exact] { return exact ? online_.updateExact() : online_.update(); },
                                            interrupt_);
     py::list changes;
@@ -435,6 +463,7 @@ class PyOnlineGrouping {
  private:
   cli::PartitionArgs args_;
   InterruptFlag interrupt_{false};
+  std::mutex busy_;
   OnlineGrouping<pcl::PointXYZ> online_;
 };
 
@@ -637,7 +666,8 @@ PYBIND11_MODULE(_obsgroup, m) {
         }
         return out;
       }, "(k, 4, 4): each member's (refined) pose in the reference frame.")
-      .def_property_readonly("filtered", [](const PyLocalMap& l) { return l.map.filtered; });
+      .def_property_readonly("filtered", [](const PyLocalMap& l) { return l.map.filtered; },
+                             "False when the map was too large for the voxel filter and kept whole.");
   m.def("_build_local_maps", &buildLocalMaps);
 
   py::class_<PlaceMap>(m, "_PlaceMap")

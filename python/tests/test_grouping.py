@@ -169,3 +169,28 @@ def test_a_callback_that_raises_stops_compute_with_its_error(data):
 
     with pytest.raises(RuntimeError, match="stop here"):
         grouping.compute(progress=fail)
+
+
+def test_another_thread_using_a_computing_grouping_gets_an_error(data):
+    import threading
+
+    scans = obsgroup.read(data / "office_2d" / "office.clf")
+    grouping = obsgroup.Grouping()
+    grouping.extend(scans)
+    errors = []
+
+    def add_from_another_thread():
+        try:
+            grouping.add(scans[0])
+        except RuntimeError as e:
+            errors.append(str(e))
+
+    def progress(stage, done, total):
+        if not errors:
+            thread = threading.Thread(target=add_from_another_thread)
+            thread.start()
+            thread.join()
+
+    grouping.compute(progress=progress)
+    assert errors and "busy" in errors[0]
+    assert len(grouping) == len(scans)  # nothing was added while it computed
