@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 const char* const OutputFolder::kResultFiles[] = {
     "partition.json", "topology.json",  "topology.dot", "map.png",       "map.svg",       "weights.png",
     "fiedler.png",    "local_maps",     "places.json",  "places.geojson", "places.png",    "places.yaml",
-    "occupancy.pgm",  "occupancy.yaml", "map_labelled.pcd", nullptr};
+    "occupancy.pgm",  "occupancy.yaml", "map_labelled.pcd", "report.html", nullptr};
 
 namespace {
 

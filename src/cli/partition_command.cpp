@@ -10,6 +10,8 @@
 #include "place_outputs.h"
 #include <obsgroup/io/pcd_sequence.h>
 #include "pictures.h"
+#include "group_colours.h"
+#include "report.h"
 #include "grouping_outcome.h"
 #include "progress_bar.h"
 #include "result_writers.h"
@@ -388,6 +390,43 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   return t;
 }
 
+/// report.html, from the results staged so far: partition.json, places.json
+/// and the local-map pictures (inside the page up to kReportPictureBytes in
+/// all; beyond, linked beside it, so that a run of thousands of places does
+/// not make a page of hundreds of megabytes).
+constexpr std::size_t kReportPictureBytes = 24u << 20;
+
+template <typename PointT>
+void writeReport(const PartitionArgs& args, const io::OutputFolder& out, const std::string& partition_json,
+                 const GroupingOutcome<PointT>& grouped, const std::vector<Observation<PointT>>& observations,
+                 const MapsOfRun<PointT>& maps) {
+  ReportInput report;
+  report.partition = nlohmann::json::parse(partition_json);
+  if (std::ifstream places(out.path("places.json")); places) report.places = nlohmann::json::parse(places);
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Eigen::Vector3d t = observations[i].pose.translation();
+    report.positions.push_back({t.x(), t.y(), grouped.partition.group_of[i]});
+  }
+  const std::vector<int> colours = render::groupColours(maps.topology);
+  for (int c : colours) report.colours.push_back(render::paletteHex(c));
+  report.pictures.resize(colours.size());
+  if (args.pictures) {
+    std::vector<std::string> bytes(colours.size());
+    std::size_t total = 0;
+    for (std::size_t g = 0; g < colours.size(); ++g) {
+      char name[64];
+      std::snprintf(name, sizeof name, "local_maps/group_%03zu.png", g);
+      report.pictures[g] = name;
+      if (std::ifstream file(out.path(name), std::ios::binary); file)
+        total += (bytes[g] = std::string(std::istreambuf_iterator<char>(file), {})).size();
+    }
+    if (total <= kReportPictureBytes)
+      for (std::size_t g = 0; g < colours.size(); ++g)
+        report.pictures[g] = bytes[g].empty() ? std::string() : pngDataUri(bytes[g]);
+  }
+  out.writeText("report.html", reportHtml(report));
+}
+
 /// What partition.json records besides the groups and the split tree.
 template <typename PointT>
 io::RunRecord runRecord(const PartitionArgs& args, const InputRecord& input, const GroupingOutcome<PointT>& grouped,
@@ -649,7 +688,9 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
       for (auto& k : run.statistics["refinement"]["unlinked"]) k = keyframes.at(k.get<std::size_t>());
     }
   }
-  out.writeText("partition.json", io::partitionJson(of_every_frame, run));
+  const std::string partition_json = io::partitionJson(of_every_frame, run);
+  out.writeText("partition.json", partition_json);
+  writeReport(args, out, partition_json, grouped, observations, maps);
   out.commit();
   if (!args.quiet) (args.stream ? printStreamSummary : printSummary)(args, run, of_every_frame.group_of.size());
   return 0;

@@ -48,6 +48,18 @@ Rgb paletteColour(int index) {
   return {rgb[sector][0] * c + m, rgb[sector][1] * c + m, rgb[sector][2] * c + m};
 }
 
+}  // namespace
+
+std::string paletteHex(int index) {
+  const Rgb c = paletteColour(index);
+  const auto byte = [](double v) { return std::clamp(static_cast<int>(std::lround(v * 255.0)), 0, 255); };
+  char text[8];
+  std::snprintf(text, sizeof text, "#%02x%02x%02x", byte(c.r), byte(c.g), byte(c.b));
+  return text;
+}
+
+namespace {
+
 Rgb darker(const Rgb& c) { return {c.r * 0.6, c.g * 0.6, c.b * 0.6}; }
 
 using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;

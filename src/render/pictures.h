@@ -28,6 +28,10 @@ using PictureWriter =
 /// Writes each picture to `folder`/name, creating the folders it needs.
 PictureWriter folderWriter(const std::string& folder);
 
+/// Colour `index` of the pictures' palette (groupColours() gives each group
+/// its index) as "#rrggbb", for pages that show the groups as the pictures do.
+std::string paletteHex(int index);
+
 /// World (re-centred) metres to picture pixels, y up.
 struct PictureView {
   double scale = 1.0, min_x = 0.0, max_y = 0.0, margin = 40.0;
