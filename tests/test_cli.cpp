@@ -226,6 +226,13 @@ void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {
   EXPECT_EQ(dot.find("e-"), std::string::npos) << "labels are fixed-point";
   expectValidPng(out / "map.png");
   expectValidSvg(out / "map.svg");
+  // The SVG's labels are text a reader can search and copy, not glyph outlines: every group's
+  // number, and the legend.
+  const std::string svg = readFile(out / "map.svg");
+  for (std::size_t g = 0; g < partition.at("groups").size(); ++g)
+    EXPECT_NE(svg.find(">" + std::to_string(g) + "</text>"), std::string::npos) << "group " << g;
+  EXPECT_NE(svg.find("observation pose (thinned where dense)</text>"), std::string::npos);
+  EXPECT_EQ(svg.find("<symbol"), std::string::npos) << "no glyph outlines";
   expectValidPng(out / "weights.png");
   expectValidPng(out / "fiedler.png");
   // The run committed its staging folder: none is left beside the results.

@@ -14,9 +14,11 @@
 #include <limits>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <iterator>
 #include <memory>
 #include <numeric>
 #include <stdexcept>
@@ -115,15 +117,67 @@ void setFont(cairo_t* cr, double size) {
   cairo_set_font_size(cr, size);
 }
 
+/// A label of an SVG picture, kept as text: cairo's SVG surface would draw
+/// its glyphs as outlines, which a reader cannot search, select or copy.
+struct SvgText {
+  double x, y, size;  ///< baseline start and font size, in the picture's pixels
+  double r, g, b;
+  std::string text;
+};
+const cairo_user_data_key_t kSvgTextKey{};
+
+/// Labels drawn on `cr` are recorded into `texts` rather than drawn.
+void recordTextInto(cairo_t* cr, std::vector<SvgText>* texts) { cairo_set_user_data(cr, &kSvgTextKey, texts, nullptr); }
+
 /// Draws `s` from (x, y) (its baseline) and returns its width.
 double text(cairo_t* cr, double x, double y, const std::string& s, double size = 14) {
   setFont(cr, size);
   cairo_text_extents_t extents;
   cairo_text_extents(cr, s.c_str(), &extents);
+  if (auto* texts = static_cast<std::vector<SvgText>*>(cairo_get_user_data(cr, &kSvgTextKey))) {
+    double dx = x, dy = y, dsize = size, zero = 0;
+    cairo_user_to_device(cr, &dx, &dy);
+    cairo_user_to_device_distance(cr, &dsize, &zero);
+    double r = 0, g = 0, b = 0, a = 1;
+    cairo_pattern_get_rgba(cairo_get_source(cr), &r, &g, &b, &a);
+    texts->push_back({dx, dy, dsize, r, g, b, s});
+    return extents.x_advance;
+  }
   cairo_move_to(cr, x, y);
   cairo_show_text(cr, s.c_str());
   cairo_new_path(cr);
   return extents.x_advance;
+}
+
+/// The recorded labels as SVG <text> elements, inserted before the closing
+/// tag of the SVG file cairo wrote at `path`.
+void insertSvgTexts(const std::string& path, const std::vector<SvgText>& texts) {
+  std::string svg;
+  {
+    std::ifstream in(path, std::ios::binary);
+    svg.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t end = svg.rfind("</svg>");
+  if (end == std::string::npos) throw std::runtime_error(path + ": cairo wrote no closing </svg>");
+  std::string elements = "<g font-family=\"sans-serif\">\n";
+  char head[200];
+  for (const SvgText& t : texts) {
+    std::snprintf(head, sizeof head, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"%.2f\" fill=\"#%02x%02x%02x\">", t.x, t.y,
+                  t.size, int(std::lround(t.r * 255)), int(std::lround(t.g * 255)), int(std::lround(t.b * 255)));
+    elements += head;
+    for (char c : t.text) {
+      if (c == '<') elements += "&lt;";
+      else if (c == '>') elements += "&gt;";
+      else if (c == '&') elements += "&amp;";
+      else elements += c;
+    }
+    elements += "</text>\n";
+  }
+  elements += "</g>\n";
+  svg.insert(end, elements);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << svg;
+  if (!out.flush()) throw std::runtime_error(path + ": cannot write the SVG");
 }
 
 /// A view of `box` (at least 1 m a side) whose longer side is `longest`
@@ -860,21 +914,24 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
   const MapLayout layout = layoutOf(world, positions, partition, topology);
   // The regions describe the input poses (they gave W) and stay there.
   const Surface points = rasterPoints(world, partition, layout, regions, places, band, heights);
-  const auto draw = [&](cairo_surface_t* target) {
+  const auto draw = [&](cairo_surface_t* target, std::vector<SvgText>* texts) {
     Context cr(cairo_create(target), cairo_destroy);
+    if (texts) recordTextInto(cr.get(), texts);
     drawMap(cr.get(), points.get(), layout, positions, headings, partition, topology, regions != nullptr, places,
             world.origin);
   };
   Surface png = imageSurface(layout.view.width, layout.view.height);
-  draw(png.get());
+  draw(png.get(), nullptr);
   writePng(out, "map.png", png.get());
   out("map.svg", [&](const std::string& temporary) {
     Surface svg(cairo_svg_surface_create(temporary.c_str(), layout.view.width, layout.view.height),
                 cairo_surface_destroy);
-    draw(svg.get());
+    std::vector<SvgText> texts;
+    draw(svg.get(), &texts);
     cairo_surface_finish(svg.get());
     if (cairo_surface_status(svg.get()) != CAIRO_STATUS_SUCCESS)
       throw std::runtime_error(temporary + ": cairo cannot write the SVG");
+    insertSvgTexts(temporary, texts);
   });
 }
 
