@@ -2,6 +2,7 @@
 // centres, the legend, distinct colours of neighbouring groups, a crop that a
 // far return does not shrink, the local maps' scale bar.
 #include "pictures.h"
+#include "png_rows.h"
 
 #include <cairo.h>
 #include <pcl/point_types.h>
@@ -341,3 +342,32 @@ TEST_F(Pictures, LocalMapsHaveAScaleBar) {
 }
 
 }  // namespace
+
+TEST(PicturePalette, AFewColoursAreTheirOwnPaletteAndMoreAreDrawnFromTheNearest) {
+  const int width = 40, height = 30;
+  std::vector<std::uint32_t> bgrx(std::size_t(width) * height, 0xffffffu);  // white, cairo's BGRX words
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < 10; ++x) bgrx[std::size_t(y) * width + x] = 0x1f77b4u;  // a band of the first colour
+  const auto bytes = reinterpret_cast<const unsigned char*>(bgrx.data());
+  auto exact = obsgroup::render::indexColours(bytes, width, height, width * 4, false);
+  ASSERT_TRUE(exact);
+  ASSERT_EQ(exact->palette.size(), 2u);
+  for (std::size_t i = 0; i < bgrx.size(); ++i) {  // every pixel is its colour again
+    const png_color c = exact->palette[exact->indices[i]];
+    EXPECT_EQ(std::uint32_t(c.red) << 16 | std::uint32_t(c.green) << 8 | c.blue, bgrx[i]) << i;
+  }
+  // 256 colours of two pixels each, and 40 more of one pixel, each a step off one of them (as an
+  // antialiased edge is): the frequent ones are the palette, each rare one drawn as its neighbour.
+  std::fill(bgrx.begin(), bgrx.end(), 0xffffffu);
+  for (std::uint32_t k = 0; k < 255; ++k) bgrx[2 * k] = bgrx[2 * k + 1] = k << 16 | 0x40u;
+  for (std::uint32_t k = 0; k < 40; ++k) bgrx[600 + k] = (k * 6) << 16 | 0x41u;
+  EXPECT_FALSE(obsgroup::render::indexColours(bytes, width, height, width * 4, false));  // not exactly
+  auto quantized = obsgroup::render::indexColours(bytes, width, height, width * 4, true);
+  ASSERT_TRUE(quantized);
+  ASSERT_EQ(quantized->palette.size(), 256u);
+  for (std::size_t i = 0; i < bgrx.size(); ++i) {
+    const png_color c = quantized->palette[quantized->indices[i]];
+    EXPECT_EQ(c.red, bgrx[i] >> 16 & 0xff) << i;
+    EXPECT_LE(std::abs(int(c.blue) - int(bgrx[i] & 0xff)), 1) << i;
+  }
+}

@@ -72,9 +72,10 @@ Surface imageSurface(int width, int height) {
   return Surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height), cairo_surface_destroy);
 }
 
-/// An ARGB32 image surface as a PNG: RGB when every pixel is opaque, else
-/// RGBA with cairo's premultiplied alpha undone.
-void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t* surface) {
+/// An ARGB32 image surface as a PNG: an 8-bit palette when every pixel is
+/// opaque and it has at most 256 colours (or `quantize`: see indexColours),
+/// RGB when it is opaque, else RGBA with cairo's premultiplied alpha undone.
+void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t* surface, bool quantize = false) {
   cairo_surface_flush(surface);
   const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
   const int stride = cairo_image_surface_get_stride(surface);
@@ -86,6 +87,8 @@ void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t
   // An opaque little-endian surface is written from its own rows; otherwise
   // as RGBA with cairo's premultiplied alpha undone.
   const bool as_is = opaque && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+  const std::optional<IndexedPixels> indexed =
+      as_is ? indexColours(data, width, height, std::size_t(stride), quantize) : std::nullopt;
   std::vector<png_byte> pixels;
   if (!as_is) {
     pixels.resize(std::size_t(width) * height * 4);
@@ -104,9 +107,10 @@ void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t
   out(name, [&](const std::string& temporary) {
     std::FILE* file = std::fopen(temporary.c_str(), "wb");
     const bool written =
-        file && (as_is ? writePngRows(file, width, height, 8, PngPixels::OpaqueBgrx, data, std::size_t(stride), true)
-                       : writePngRows(file, width, height, 8, PngPixels::Rgba, pixels.data(), std::size_t(width) * 4,
-                                      true));
+        file && (indexed ? writePalettePng(file, width, height, *indexed)
+                 : as_is ? writePngRows(file, width, height, 8, PngPixels::OpaqueBgrx, data, std::size_t(stride), true)
+                         : writePngRows(file, width, height, 8, PngPixels::Rgba, pixels.data(),
+                                        std::size_t(width) * 4, true));
     if (file && std::fclose(file) != 0) throw std::runtime_error(temporary + ": cannot write the PNG");
     if (!written) throw std::runtime_error(temporary + ": cannot write the PNG");
   });
@@ -864,7 +868,8 @@ void writeLocalMapPicture(const PictureWriter& out, int group, const LocalMapFra
   text(cr.get(), v.margin, v.height - 12, caption, 12);
   char name[64];
   std::snprintf(name, sizeof name, "local_maps/group_%03d.png", group);
-  writePng(out, name, surface.get());
+  // A few colours and their antialiased edges: drawn from a palette, a third of the bytes to compress.
+  writePng(out, name, surface.get(), true);
 }
 
 }  // namespace

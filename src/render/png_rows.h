@@ -4,8 +4,14 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
+#include <optional>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace obsgroup::render {
 
@@ -47,6 +53,102 @@ inline bool writePngRows(std::FILE* file, int width, int height, int bit_depth, 
     png_set_bgr(png);
   }
   for (int r = 0; r < height; ++r) png_write_row(png, rows + std::size_t(r) * row_bytes);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+/// An opaque picture as palette indices, one byte a pixel: a third of the
+/// bytes of RGB for zlib to compress.
+struct IndexedPixels {
+  std::vector<png_color> palette;
+  std::vector<png_byte> indices;  ///< row by row, `width` a row
+};
+
+/// The colours of an opaque picture in cairo's BGRX rows as a palette: exact
+/// when it has at most 256 colours. Otherwise, with `quantize`, the 256 most
+/// frequent (ties: the smaller colour) and every other colour drawn as the
+/// nearest of them: in a drawing of a few colours, the rare ones are
+/// antialiased edges between them. Without `quantize`, none.
+inline std::optional<IndexedPixels> indexColours(const unsigned char* bgrx, int width, int height,
+                                                 std::size_t row_bytes, bool quantize) {
+  const auto pixel = [&](int x, int y) {
+    return reinterpret_cast<const std::uint32_t*>(bgrx + std::size_t(y) * row_bytes)[x] & 0xffffffu;
+  };
+  std::unordered_map<std::uint32_t, std::size_t> counts;
+  for (int y = 0; y < height; ++y) {
+    std::uint32_t last = pixel(0, y);
+    std::size_t run = 0;
+    for (int x = 0; x < width; ++x) {
+      const std::uint32_t c = pixel(x, y);
+      if (c == last) {
+        ++run;
+        continue;
+      }
+      counts[last] += run;
+      last = c, run = 1;
+    }
+    counts[last] += run;
+    if (!quantize && counts.size() > 256) return std::nullopt;
+  }
+  std::vector<std::pair<std::size_t, std::uint32_t>> by_count;  // (count, colour)
+  for (const auto& [colour, count] : counts) by_count.push_back({count, colour});
+  std::sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  const std::size_t kept = std::min<std::size_t>(256, by_count.size());
+  IndexedPixels out;
+  std::unordered_map<std::uint32_t, png_byte> index;
+  for (std::size_t k = 0; k < kept; ++k) {
+    const std::uint32_t c = by_count[k].second;
+    out.palette.push_back({png_byte(c >> 16), png_byte(c >> 8), png_byte(c)});
+    index[c] = png_byte(k);
+  }
+  for (std::size_t k = kept; k < by_count.size(); ++k) {  // the nearest kept colour
+    const std::uint32_t c = by_count[k].second;
+    long best_distance = -1;
+    png_byte best = 0;
+    for (std::size_t j = 0; j < kept; ++j) {
+      const long dr = long(c >> 16 & 0xff) - out.palette[j].red, dg = long(c >> 8 & 0xff) - out.palette[j].green,
+                 db = long(c & 0xff) - out.palette[j].blue;
+      const long distance = dr * dr + dg * dg + db * db;
+      if (best_distance < 0 || distance < best_distance) best_distance = distance, best = png_byte(j);
+    }
+    index[c] = best;
+  }
+  out.indices.resize(std::size_t(width) * height);
+  for (int y = 0; y < height; ++y) {
+    std::uint32_t last = pixel(0, y);
+    png_byte last_index = index.at(last);
+    png_byte* row = &out.indices[std::size_t(y) * width];
+    for (int x = 0; x < width; ++x) {
+      const std::uint32_t c = pixel(x, y);
+      if (c != last) last = c, last_index = index.at(c);
+      row[x] = last_index;
+    }
+  }
+  return out;
+}
+
+/// An 8-bit palette PNG of `pixels` (indexColours), zlib level 1 and no
+/// filter (the PNG specification's advice for palette images). Returns false
+/// on an error.
+inline bool writePalettePng(std::FILE* file, int width, int height, const IndexedPixels& pixels) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  if (!png) return false;
+  png_infop info = png_create_info_struct(png);
+  if (!info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_PALETTE, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_PLTE(png, info, pixels.palette.data(), int(pixels.palette.size()));
+  png_set_compression_level(png, 1);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+  png_write_info(png, info);
+  for (int r = 0; r < height; ++r) png_write_row(png, &pixels.indices[std::size_t(r) * width]);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return true;
