@@ -123,6 +123,10 @@ TEST(Places, OutlinesAreValidPolygonsAndDoorsJoinNeighbours) {
       std::size_t cells = 0;
       for (int l : map.labels) cells += l == place.id;
       EXPECT_NEAR(double(cells) * cell_area, place.area_m2, 1e-9);
+      // Its name goes on its own floor, never beside it.
+      const Eigen::Vector2i cell = map.grid.cellOf(place.label_point);
+      ASSERT_TRUE(map.grid.contains(cell.x(), cell.y()));
+      EXPECT_EQ(map.labels[map.grid.index(cell.x(), cell.y())], place.id);
     }
   }
   EXPECT_GT(total, 50.0);  // the office's floor, most of it

@@ -63,6 +63,7 @@ std::string placesJson(const PlaceMap& map) {
                       {"members", p.members},
                       {"area_m2", p.area_m2},
                       {"centroid", p.area_m2 > 0 ? xy(p.centroid) : nlohmann::json()},
+                      {"label_point", p.area_m2 > 0 ? xy(p.label_point) : nlohmann::json()},
                       {"bbox", bboxJson(p.bbox)},
                       {"neighbours", p.neighbours},
                       {"outline", outline}});

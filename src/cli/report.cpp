@@ -144,7 +144,7 @@ for (const door of D.doors || []) {
 }
 for (let g = 0; g < G; ++g) {
   const p = placeOf.get(ids[g]);
-  let c = p && p.outline.length ? p.centroid : null;
+  let c = p && p.outline.length ? (p.label_point || p.centroid) : null;
   if (!c) {  // no floor: the mean of its dots
     let sx = 0, sy = 0, n = 0;
     for (const [x, y, h] of D.positions) if (h === g) { sx += x; sy += y; ++n; }

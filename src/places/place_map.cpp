@@ -448,6 +448,45 @@ bool inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) 
   return in;
 }
 
+/// Each label's cell farthest from any cell of another label (or none, or
+/// the grid's edge), by a two-pass chamfer distance (3 along an edge, 4
+/// across a corner); ties go to the first cell in row order.
+std::vector<std::size_t> deepestCells(const FloorGrid& g, const std::vector<int>& label, std::size_t labels) {
+  constexpr int kFar = std::numeric_limits<int>::max() / 2;
+  std::vector<int> distance(label.size(), kFar);
+  const auto at = [&](int i, int j) { return g.contains(i, j) ? distance[g.index(i, j)] : 0; };
+  const auto same = [&](int i, int j, int l) { return g.contains(i, j) && label[g.index(i, j)] == l; };
+  for (int j = 0; j < g.height; ++j)
+    for (int i = 0; i < g.width; ++i) {
+      const int l = label[g.index(i, j)];
+      int& d = distance[g.index(i, j)];
+      if (l == kNone) { d = 0; continue; }
+      d = std::min(d, same(i - 1, j, l) ? at(i - 1, j) + 3 : 3);
+      d = std::min(d, same(i, j - 1, l) ? at(i, j - 1) + 3 : 3);
+      d = std::min(d, same(i - 1, j - 1, l) ? at(i - 1, j - 1) + 4 : 4);
+      d = std::min(d, same(i + 1, j - 1, l) ? at(i + 1, j - 1) + 4 : 4);
+    }
+  for (int j = g.height - 1; j >= 0; --j)
+    for (int i = g.width - 1; i >= 0; --i) {
+      const int l = label[g.index(i, j)];
+      if (l == kNone) continue;
+      int& d = distance[g.index(i, j)];
+      d = std::min(d, same(i + 1, j, l) ? at(i + 1, j) + 3 : 3);
+      d = std::min(d, same(i, j + 1, l) ? at(i, j + 1) + 3 : 3);
+      d = std::min(d, same(i + 1, j + 1, l) ? at(i + 1, j + 1) + 4 : 4);
+      d = std::min(d, same(i - 1, j + 1, l) ? at(i - 1, j + 1) + 4 : 4);
+    }
+  std::vector<std::size_t> deepest(labels, 0);
+  std::vector<int> best(labels, -1);
+  for (std::size_t k = 0; k < label.size(); ++k)
+    if (const int l = label[k]; l != kNone && distance[k] > best[std::size_t(l)]) {
+      best[std::size_t(l)] = distance[k];
+      deepest[std::size_t(l)] = k;
+    }
+  return deepest;
+}
+
+
 }  // namespace
 
 std::vector<std::vector<std::size_t>> polygonsOf(const std::vector<std::vector<Eigen::Vector2d>>& rings) {
@@ -575,9 +614,11 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
         if (u != kNone && u != l) touches[l][u] = touches[u][l] = 1;
       }
     }
+  const std::vector<std::size_t> deepest = deepestCells(g, label, groups.size());
   for (std::size_t k = 0; k < groups.size(); ++k) {
     Place& place = map.places[k];
     place.id = place_ids[k];
+    if (cell_count[k] > 0) place.label_point = g.cellCentre(int(deepest[k] % g.width), int(deepest[k] / g.width));
     place.members = groups[k];
     place.area_m2 = double(cell_count[k]) * cell_area;
     if (cell_count[k] > 0) place.centroid = centre_sum[k] / double(cell_count[k]);

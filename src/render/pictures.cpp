@@ -604,7 +604,7 @@ void legendMarks(cairo_t* cr, const View& v, double row, const LegendText& t, co
   groupMark(cr, v.margin + 11, row, 7, sample, true, sizes);
   cairo_set_source_rgb(cr, 0, 0, 0);
   double x = v.margin + 28;
-  x += text(cr, x, row + 4, "group, at its observations' mean", 12) + 14;
+  x += text(cr, x, row + 4, t.places ? "group, on its floor" : "group, at its observations' mean", 12) + 14;
   if (t.numbered < t.groups) {
     groupMark(cr, x + 5, row, 0, sample, false, sizes);
     cairo_set_source_rgb(cr, 0, 0, 0);
@@ -744,7 +744,7 @@ WorldPoints atDrawnPoses(const WorldPoints& world, const std::vector<Eigen::Isom
 /// The layout of the map of `world` (already at the drawn poses) whose
 /// observations are at `positions` (re-centred like `world`).
 MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions,
-                   const Partition& partition, const TopologicalMap& topology) {
+                   const Partition& partition, const TopologicalMap& topology, const PlaceMap* places = nullptr) {
   MapLayout layout;
   const Eigen::AlignedBox2d box =
       bulkBox(world.points.data(), world.points.data() + world.points.size(), positions, 0.025);
@@ -753,6 +753,11 @@ MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>&
   layout.view = fitView(box, longest, 1100, kLegendHeight);
   layout.legend_top = layout.view.height - kLegendHeight;
   layout.centres = groupCentres(layout.view, positions, partition);
+  if (places && places->places.size() == partition.groups.size())  // the number on its tint
+    for (std::size_t g = 0; g < partition.groups.size(); ++g)
+      if (const Place& place = places->places[g]; place.area_m2 > 0)
+        layout.centres[g] = Eigen::Vector2d(layout.view.px(place.label_point.x() - world.origin.x()),
+                                            layout.view.py(place.label_point.y() - world.origin.y()));
   layout.colours = groupColours(topology);
   layout.colours.resize(partition.groups.size(), 0);  // a topology of other groups
   layout.shown_arcs = shownArcs(topology, kArcsPerGroup);
@@ -916,7 +921,7 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
     for (const auto& pose : drawn) heights.push_back(pose.translation().z() - world.origin.z());
     world = withinBand(world, heights, *band);
   }
-  const MapLayout layout = layoutOf(world, positions, partition, topology);
+  const MapLayout layout = layoutOf(world, positions, partition, topology, places);
   // The regions describe the input poses (they gave W) and stay there.
   const Surface points = rasterPoints(world, partition, layout, regions, places, band, heights);
   const auto draw = [&](cairo_surface_t* target, std::vector<SvgText>* texts) {

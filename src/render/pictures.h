@@ -47,7 +47,9 @@ struct MapLayout {
   /// margin, so that a few far returns do not shrink the building.
   PictureView view;
   int legend_top = 0;                    ///< The legend: rows [legend_top, view.height).
-  std::vector<Eigen::Vector2d> centres;  ///< Each group's mean position, in pixels.
+  /// Where each group's mark is, in pixels: on its place's floor (Place::label_point)
+  /// when the map has places and the place has floor, else at its observations' mean.
+  std::vector<Eigen::Vector2d> centres;
   std::vector<int> colours;              ///< groupColours()
   std::vector<std::size_t> shown_arcs;   ///< shownArcs()
   /// Whether each group's mark is a numbered circle of `label_radius` pixels

@@ -47,6 +47,10 @@ struct Place {
   std::vector<std::vector<Eigen::Vector2d>> outline;
   double area_m2 = 0.0;
   Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  /// Where to write the place's name: the centre of its cell farthest from
+  /// the edge of its floor, always on its floor (a corridor's or an L-shaped
+  /// room's centroid may lie outside it).
+  Eigen::Vector2d label_point = Eigen::Vector2d::Zero();
   Eigen::AlignedBox2d bbox;    ///< of the outline (empty when the place holds no floor)
   std::vector<int> neighbours; ///< ids of the places whose floor touches this one's, ascending
 };
