@@ -345,22 +345,23 @@ TEST_F(Pictures, LocalMapsHaveAScaleBar) {
 
 TEST(PicturePalette, AFewColoursAreTheirOwnPaletteAndMoreAreDrawnFromTheNearest) {
   const int width = 40, height = 30;
-  std::vector<std::uint32_t> bgrx(std::size_t(width) * height, 0xffffffu);  // white, cairo's BGRX words
+  constexpr std::uint32_t kOpaque = 0xff000000u;
+  std::vector<std::uint32_t> bgrx(std::size_t(width) * height, kOpaque | 0xffffffu);  // white, cairo's ARGB32 words
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < 10; ++x) bgrx[std::size_t(y) * width + x] = 0x1f77b4u;  // a band of the first colour
+    for (int x = 0; x < 10; ++x) bgrx[std::size_t(y) * width + x] = kOpaque | 0x1f77b4u;  // a band of the first colour
   const auto bytes = reinterpret_cast<const unsigned char*>(bgrx.data());
   auto exact = obsgroup::render::indexColours(bytes, width, height, width * 4, false);
   ASSERT_TRUE(exact);
   ASSERT_EQ(exact->palette.size(), 2u);
   for (std::size_t i = 0; i < bgrx.size(); ++i) {  // every pixel is its colour again
     const png_color c = exact->palette[exact->indices[i]];
-    EXPECT_EQ(std::uint32_t(c.red) << 16 | std::uint32_t(c.green) << 8 | c.blue, bgrx[i]) << i;
+    EXPECT_EQ(kOpaque | std::uint32_t(c.red) << 16 | std::uint32_t(c.green) << 8 | c.blue, bgrx[i]) << i;
   }
   // 256 colours of two pixels each, and 40 more of one pixel, each a step off one of them (as an
   // antialiased edge is): the frequent ones are the palette, each rare one drawn as its neighbour.
-  std::fill(bgrx.begin(), bgrx.end(), 0xffffffu);
-  for (std::uint32_t k = 0; k < 255; ++k) bgrx[2 * k] = bgrx[2 * k + 1] = k << 16 | 0x40u;
-  for (std::uint32_t k = 0; k < 40; ++k) bgrx[600 + k] = (k * 6) << 16 | 0x41u;
+  std::fill(bgrx.begin(), bgrx.end(), kOpaque | 0xffffffu);
+  for (std::uint32_t k = 0; k < 255; ++k) bgrx[2 * k] = bgrx[2 * k + 1] = kOpaque | k << 16 | 0x40u;
+  for (std::uint32_t k = 0; k < 40; ++k) bgrx[600 + k] = kOpaque | (k * 6) << 16 | 0x41u;
   EXPECT_FALSE(obsgroup::render::indexColours(bytes, width, height, width * 4, false));  // not exactly
   auto quantized = obsgroup::render::indexColours(bytes, width, height, width * 4, true);
   ASSERT_TRUE(quantized);
@@ -370,4 +371,6 @@ TEST(PicturePalette, AFewColoursAreTheirOwnPaletteAndMoreAreDrawnFromTheNearest)
     EXPECT_EQ(c.red, bgrx[i] >> 16 & 0xff) << i;
     EXPECT_LE(std::abs(int(c.blue) - int(bgrx[i] & 0xff)), 1) << i;
   }
+  bgrx[5] = 0x80808080u;  // one translucent pixel: no palette, the picture keeps its alpha
+  EXPECT_FALSE(obsgroup::render::indexColours(bytes, width, height, width * 4, true));
 }

@@ -80,15 +80,16 @@ void writePng(const PictureWriter& out, const std::string& name, cairo_surface_t
   const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
   const int stride = cairo_image_surface_get_stride(surface);
   const unsigned char* data = cairo_image_surface_get_data(surface);
-  bool opaque = true;
-  for (int y = 0; y < height && opaque; ++y)
+  constexpr bool little_endian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+  const std::optional<IndexedPixels> indexed =
+      little_endian ? indexColours(data, width, height, std::size_t(stride), quantize) : std::nullopt;
+  bool opaque = true;  // so is every picture with a palette
+  for (int y = 0; y < height && opaque && !indexed; ++y)
     for (int x = 0; x < width && opaque; ++x)
       opaque = (reinterpret_cast<const std::uint32_t*>(data + y * stride)[x] >> 24) == 0xff;
   // An opaque little-endian surface is written from its own rows; otherwise
   // as RGBA with cairo's premultiplied alpha undone.
-  const bool as_is = opaque && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
-  const std::optional<IndexedPixels> indexed =
-      as_is ? indexColours(data, width, height, std::size_t(stride), quantize) : std::nullopt;
+  const bool as_is = indexed || (opaque && little_endian);
   std::vector<png_byte> pixels;
   if (!as_is) {
     pixels.resize(std::size_t(width) * height * 4);
