@@ -72,7 +72,7 @@ class ColourTable {
   struct Entry {
     std::uint32_t colour = kEmpty;
     std::uint32_t count = 0;
-    png_byte index = 0;
+    std::uint16_t order = 0;  ///< the colours in the order they were first met
   };
   static constexpr std::uint32_t kEmpty = 0xffffffffu;  // no 24-bit colour
 
@@ -85,6 +85,7 @@ class ColourTable {
         k = slot(colour);
       }
       slots_[k].colour = colour;
+      slots_[k].order = std::uint16_t(size_);
       ++size_;
     }
     return slots_[k];
@@ -116,33 +117,42 @@ class ColourTable {
 /// none either when a pixel is not opaque.
 inline std::optional<IndexedPixels> indexColours(const unsigned char* bgrx, int width, int height,
                                                  std::size_t row_bytes, bool quantize) {
-  const auto row_of = [&](int y) { return reinterpret_cast<const std::uint32_t*>(bgrx + std::size_t(y) * row_bytes); };
+  // One pass over the picture, run by run: each colour counted and each pixel
+  // given its colour's order of appearance; the palette index follows from it.
+  constexpr std::size_t kMaxColours = 65535;  // orders fit 16 bits; a drawing has a few hundred
+  thread_local std::vector<std::uint16_t> order;
+  order.resize(std::size_t(width) * height);
   ColourTable table;
+  std::vector<std::uint32_t> colours;  // by order
   for (int y = 0; y < height; ++y) {
-    const std::uint32_t* row = row_of(y);
+    const auto* row = reinterpret_cast<const std::uint32_t*>(bgrx + std::size_t(y) * row_bytes);
+    std::uint16_t* orders = &order[std::size_t(y) * width];
     int x = 0;
-    while (x < width) {  // a run of one colour at a time
+    while (x < width) {
       const std::uint32_t word = row[x];
       if (word >> 24 != 0xffu) return std::nullopt;  // not opaque: no palette
       int end = x + 1;
       while (end < width && row[end] == word) ++end;
-      table[word & 0xffffffu].count += std::uint32_t(end - x);
+      ColourTable::Entry& e = table[word & 0xffffffu];
+      if (e.count == 0) colours.push_back(word & 0xffffffu);
+      e.count += std::uint32_t(end - x);
+      std::fill(orders + x, orders + end, e.order);
       x = end;
     }
-    if (!quantize && table.size() > 256) return std::nullopt;
+    if ((!quantize && table.size() > 256) || table.size() > kMaxColours) return std::nullopt;
   }
   std::vector<std::pair<std::uint32_t, std::uint32_t>> by_count;  // (count, colour)
-  for (const auto& e : table.slots())
-    if (e.colour != ColourTable::kEmpty) by_count.push_back({e.count, e.colour});
+  for (std::uint32_t c : colours) by_count.push_back({table[c].count, c});
   std::sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first > b.first : a.second < b.second;
   });
   const std::size_t kept = std::min<std::size_t>(256, by_count.size());
   IndexedPixels out;
+  std::vector<png_byte> index_of_order(colours.size(), 0);
   for (std::size_t k = 0; k < kept; ++k) {
     const std::uint32_t c = by_count[k].second;
     out.palette.push_back({png_byte(c >> 16), png_byte(c >> 8), png_byte(c)});
-    table[c].index = png_byte(k);
+    index_of_order[table[c].order] = png_byte(k);
   }
   for (std::size_t k = kept; k < by_count.size(); ++k) {  // the nearest kept colour
     const std::uint32_t c = by_count[k].second;
@@ -154,21 +164,10 @@ inline std::optional<IndexedPixels> indexColours(const unsigned char* bgrx, int 
       const long distance = dr * dr + dg * dg + db * db;
       if (best_distance < 0 || distance < best_distance) best_distance = distance, best = png_byte(j);
     }
-    table[c].index = best;
+    index_of_order[table[c].order] = best;
   }
-  out.indices.resize(std::size_t(width) * height);
-  for (int y = 0; y < height; ++y) {
-    const std::uint32_t* row = row_of(y);
-    png_byte* indices = &out.indices[std::size_t(y) * width];
-    int x = 0;
-    while (x < width) {
-      const std::uint32_t word = row[x];
-      int end = x + 1;
-      while (end < width && row[end] == word) ++end;
-      std::fill(indices + x, indices + end, table[word & 0xffffffu].index);
-      x = end;
-    }
-  }
+  out.indices.resize(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) out.indices[i] = index_of_order[order[i]];
   return out;
 }
 
