@@ -117,6 +117,23 @@ Eigen::Vector3d ObservationRegions::cellCentre(std::uint64_t key) const {
   return (cell + Eigen::Vector3d::Constant(0.5) - phase) * cell_size;
 }
 
+bool ObservationRegions::planeBounds(Eigen::Vector3d& lowest, Eigen::Vector3d& highest) const {
+  if (cells.empty()) return false;
+  // A cell's x and y coordinates are fields of its key; the centre grows with each.
+  const int x_shift = planar ? 32 : 42, y_shift = planar ? 0 : 21;
+  const std::uint64_t y_mask = planar ? 0xffffffffu : (std::uint64_t(1) << 21) - 1;
+  std::uint64_t x_lo = ~std::uint64_t(0), x_hi = 0, y_lo = ~std::uint64_t(0), y_hi = 0;
+  for (std::uint64_t key : cells) {
+    const std::uint64_t x = key >> x_shift, y = (key >> y_shift) & y_mask;
+    x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
+    y_lo = std::min(y_lo, y), y_hi = std::max(y_hi, y);
+  }
+  const std::uint64_t z = planar ? 0 : cells.front() & ((std::uint64_t(1) << 21) - 1);
+  lowest = cellCentre(x_lo << x_shift | y_lo << y_shift | z);
+  highest = cellCentre(x_hi << x_shift | y_hi << y_shift | z);
+  return true;
+}
+
 namespace {
 
 /// Each observation's region as its own list of keys (ascending), and

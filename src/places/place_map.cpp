@@ -4,6 +4,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -71,14 +73,11 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) 
   // Cell edges where the regions' are: a corner half a cell below a region cell's centre.
   const Eigen::Vector3d first = regions.cellCentre(regions.cells.front());
   f.base = Eigen::Vector2d(first.x() - cs / 2, first.y() - cs / 2);
-  Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max());
-  Eigen::Vector2i hi = Eigen::Vector2i::Constant(std::numeric_limits<int>::min());
-  for (std::uint64_t key : regions.cells) {
-    const Eigen::Vector3d c = regions.cellCentre(key);
-    const Eigen::Vector2i cell(f.cellX(c.x()), f.cellY(c.y()));  // `first` is still (0, 0)
-    lo = lo.cwiseMin(cell);
-    hi = hi.cwiseMax(cell);
-  }
+  // The extreme cells by their keys: cellX and cellY grow with a cell's coordinates.
+  Eigen::Vector3d lowest, highest;
+  regions.planeBounds(lowest, highest);
+  const Eigen::Vector2i lo(f.cellX(lowest.x()), f.cellY(lowest.y()));  // `first` is still (0, 0)
+  const Eigen::Vector2i hi(f.cellX(highest.x()), f.cellY(highest.y()));
   const Eigen::Vector2d size = (hi - lo).cast<double>() + Eigen::Vector2d::Constant(3);
   if (size.x() * size.y() > 4.0e8)
     throw std::invalid_argument("buildPlaceMap: the floor grid would have more than 400 million cells of " +
@@ -90,43 +89,61 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) 
   return f;
 }
 
-/// The cells a beam crosses on its way from the sensor to a point (seen from
-/// above; the point's own cell excluded), by a grid traversal (Amanatides &
-/// Woo) of every observation's every point.
-std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensors) {
+/// Marks in `crossed` the cells a beam of observation i crosses on its way
+/// from the sensor to a point (seen from above; the point's own cell
+/// excluded), by a grid traversal (Amanatides & Woo).
+void markRays(const GridFrame& f, const WorldPoints& world, const Eigen::Vector3d& sensor, int i,
+              std::vector<char>& crossed) {
   const FloorGrid& g = f.grid;
-  std::vector<char> crossed(std::size_t(g.width) * std::size_t(g.height), 0);
   // Positions in cells of the grid, as GridFrame::cellX/cellY put them.
   const Eigen::Vector2d corner = f.base + g.resolution * f.first.cast<double>();
-  for (int i = 0; i < world.size(); ++i) {
-    const double sx = (sensors[i].x() - corner.x()) / g.resolution;
-    const double sy = (sensors[i].y() - corner.y()) / g.resolution;
-    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
-      const double ex = (double(p->x()) - corner.x()) / g.resolution;
-      const double ey = (double(p->y()) - corner.y()) / g.resolution;
-      int x = int(std::floor(sx)), y = int(std::floor(sy));
-      const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
-      const double dx = ex - sx, dy = ey - sy;
-      const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
-      const double inf = std::numeric_limits<double>::infinity();
-      const double delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
-      double next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
-      double next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
-      // Beyond the grid a ray marks nothing: stop where it leaves for good.
-      const int steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
-      for (int k = 0; k < steps; ++k) {
-        if (g.contains(x, y)) crossed[g.index(x, y)] = 1;
-        if (next_x < next_y) {
-          next_x += delta_x;
-          x += step_x;
-        } else {
-          next_y += delta_y;
-          y += step_y;
-        }
+  const double sx = (sensor.x() - corner.x()) / g.resolution;
+  const double sy = (sensor.y() - corner.y()) / g.resolution;
+  for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+    const double ex = (double(p->x()) - corner.x()) / g.resolution;
+    const double ey = (double(p->y()) - corner.y()) / g.resolution;
+    int x = int(std::floor(sx)), y = int(std::floor(sy));
+    const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
+    const double dx = ex - sx, dy = ey - sy;
+    const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+    const double inf = std::numeric_limits<double>::infinity();
+    const double delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
+    double next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
+    double next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
+    // Beyond the grid a ray marks nothing: stop where it leaves for good.
+    const int steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
+    for (int k = 0; k < steps; ++k) {
+      if (g.contains(x, y)) crossed[g.index(x, y)] = 1;
+      if (next_x < next_y) {
+        next_x += delta_x;
+        x += step_x;
+      } else {
+        next_y += delta_y;
+        y += step_y;
       }
     }
   }
-  return crossed;
+}
+
+/// The cells some beam crossed: every observation's every ray, traversed on every thread, each into its own
+/// grid, OR-ed together (the same cells for any thread count). A grid too
+/// large to copy per thread is traversed on one.
+std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensors) {
+  const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
+  const int n = world.size();
+  constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
+  const int threads = std::max(1, std::min({omp_get_max_threads(), n, int(kMaxCopiedBytes / std::max<std::size_t>(cells, 1))}));
+  std::vector<std::vector<char>> crossed(static_cast<std::size_t>(threads));
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<char>& mine = crossed[std::size_t(omp_get_thread_num())];
+    mine.assign(cells, 0);
+#pragma omp for schedule(dynamic, 16)
+    for (int i = 0; i < n; ++i) markRays(f, world, sensors[std::size_t(i)], i, mine);
+  }
+  for (std::size_t t = 1; t < crossed.size(); ++t)
+    for (std::size_t k = 0; k < cells; ++k) crossed[0][k] |= crossed[t][k];
+  return std::move(crossed[0]);
 }
 
 /// The grid cell of every region cell (regions.cells' order; 3D voxels

@@ -109,6 +109,11 @@ struct ObservationRegions {
   /// The centre of a cell in the re-centred frame of the WorldPoints the
   /// regions were computed from (for plane cells, z is the grid's 0).
   Eigen::Vector3d cellCentre(std::uint64_t key) const;
+  /// The centres of the lowest and the highest cell along x and along y over
+  /// all regions (z: the first cell's), as cellCentre gives them; found from
+  /// the keys' integer coordinates, without a centre per cell. False when
+  /// there is no cell.
+  bool planeBounds(Eigen::Vector3d& lowest, Eigen::Vector3d& highest) const;
 };
 
 /// The regions of `world`'s observations under `model` (FreeSpace or
