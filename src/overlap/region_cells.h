@@ -104,11 +104,20 @@ class RegionMarker {
   }
   /// Appends the marked keys, ascending.
   void emit(std::vector<std::uint64_t>& out) {
+    forEachMarked([&out](std::uint64_t key) { out.push_back(key); });
+  }
+  /// Calls visit(key) for each marked cell, keys ascending.
+  template <typename Visit>
+  void forEachMarked(Visit&& visit) {
     if (!dense_) {
       std::sort(keys_.begin(), keys_.end());
       keys_.erase(std::unique(keys_.begin(), keys_.end()), keys_.end());
       std::sort(removed_.begin(), removed_.end());
-      std::set_difference(keys_.begin(), keys_.end(), removed_.begin(), removed_.end(), std::back_inserter(out));
+      auto removed = removed_.begin();
+      for (std::uint64_t key : keys_) {
+        while (removed != removed_.end() && *removed < key) ++removed;
+        if (removed == removed_.end() || *removed != key) visit(key);
+      }
       return;
     }
     for (std::size_t w = 0; w < bits_.size(); ++w)
@@ -119,7 +128,7 @@ class RegionMarker {
           c[a] = lo_[a] + std::int64_t(b % std::uint64_t(extent_[a]));
           b /= std::uint64_t(extent_[a]);
         }
-        out.push_back(keyOf<D>(c));
+        visit(keyOf<D>(c));
       }
   }
 
@@ -357,9 +366,10 @@ struct EvidenceScratch {
 /// One observation's evidence for the occupancy grid: the plane cells its
 /// points (in the band) lie in, and the cells its beams cross within range
 /// without ending there, both ascending.
-inline void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
-                              const CellGrid& grid, bool planar, EvidenceScratch& s, std::vector<std::uint64_t>& hit,
-                              std::vector<std::uint64_t>& crossed) {
+/// Each key is passed once, in ascending order: hit(key), then crossed(key).
+template <typename OnHit, typename OnCrossed>
+void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
+                       const CellGrid& grid, bool planar, EvidenceScratch& s, OnHit&& hit, OnCrossed&& crossed) {
   if (points.empty()) return;
   const double range = params.max_range / grid.size;
   s.ends.clear();
@@ -381,7 +391,7 @@ inline void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, c
   }
   s.marker.reset(lo, hi);
   for (const Cell<2>& c : s.ends) s.marker.mark(c);
-  s.marker.emit(hit);
+  s.marker.forEachMarked(hit);
   s.marker.reset(lo, hi);
   for (const auto& e : s.targets)
     traverse<2>(o, e, [&](const Cell<2>& c, double) {
@@ -389,7 +399,16 @@ inline void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, c
       return true;
     });
   for (const Cell<2>& c : s.ends) s.marker.unmark(c);  // a surface it saw is not a cell it saw through
-  s.marker.emit(crossed);
+  s.marker.forEachMarked(crossed);
+}
+
+/// occupancyEvidence as two lists of keys, ascending.
+inline void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
+                              const CellGrid& grid, bool planar, EvidenceScratch& s, std::vector<std::uint64_t>& hit,
+                              std::vector<std::uint64_t>& crossed) {
+  occupancyEvidence(
+      points, origin, params, grid, planar, s, [&hit](std::uint64_t key) { hit.push_back(key); },
+      [&crossed](std::uint64_t key) { crossed.push_back(key); });
 }
 
 /// Whether a cell with this evidence is occupied (RegionParameters::min_observations).

@@ -1,5 +1,6 @@
 #include "obsgroup/overlap/sensed_regions.h"
 
+#include "cell_tiles.h"
 #include "region_cells.h"
 
 #include "obsgroup/common/parallel_for.h"
@@ -16,9 +17,6 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#if defined(__GLIBCXX__) && defined(_OPENMP)
-#include <parallel/algorithm>
-#endif
 
 namespace obsgroup {
 
@@ -26,58 +24,44 @@ namespace {
 
 using namespace region_cells;
 
-/// Sorts distinct-or-integer values in parallel: one order whatever the threads.
-template <typename T>
-void sortInParallel(std::vector<T>& values) {
-#if defined(__GLIBCXX__) && defined(_OPENMP)
-  __gnu_parallel::sort(values.begin(), values.end());
-#else
-  std::sort(values.begin(), values.end());
-#endif
-}
-
-/// Concatenates per-observation key lists (freeing them) and sorts them.
-std::vector<std::uint64_t> gatherSorted(std::vector<std::vector<std::uint64_t>>& per_observation) {
-  std::size_t total = 0;
-  for (const auto& keys : per_observation) total += keys.size();
-  std::vector<std::uint64_t> all;
-  all.reserve(total);
-  for (auto& keys : per_observation) {
-    all.insert(all.end(), keys.begin(), keys.end());
-    std::vector<std::uint64_t>().swap(keys);
-  }
-  sortInParallel(all);
-  return all;
-}
-
 /// The plane cells occupied in the evidence of all observations: at least
 /// params.min_observations observations have a point in the cell, and at
 /// least as many have a point in it as have a beam through it. A wall seen
 /// once, by a sparse sequence, stands; a drifted copy of a wall across a door,
-/// which the beams of everyone passing the door cross, does not.
+/// which the beams of everyone passing the door cross, does not. The evidence
+/// is tallied per cell as it is found, never held as lists.
 std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::vector<Eigen::Vector3d>& origins,
                                          const RegionParameters& params, const CellGrid& grid, bool planar,
                                          int threads) {
   const int n = world.size();
-  std::vector<std::vector<std::uint64_t>> hit(n), crossed(n);
-  parallelForWithScratch(
-      n, threads, 16, [] { return EvidenceScratch{}; },
-      [&](std::size_t i, EvidenceScratch& s) {
-        occupancyEvidence(pointsOf(world, int(i)), origins[i], params, grid, planar, s, hit[i], crossed[i]);
-      });
-  const std::vector<std::uint64_t> hits = gatherSorted(hit), misses = gatherSorted(crossed);
-  std::vector<std::uint64_t> occupied;
-  std::size_t m = 0;
-  for (std::size_t a = 0; a < hits.size();) {
-    std::size_t b = a;
-    while (b < hits.size() && hits[b] == hits[a]) ++b;
-    while (m < misses.size() && misses[m] < hits[a]) ++m;
-    std::size_t e = m;
-    while (e < misses.size() && misses[e] == hits[a]) ++e;
-    if (occupiedBy(b - a, e - m, params)) occupied.push_back(hits[a]);
-    a = b;
-    m = e;
+  // An observation's evidence lies in the box of its sensor and its points
+  // (its beams are clipped towards the sensor): those tiles are added first.
+  CellTiles tiles(true);
+  for (int i = 0; i < n; ++i) {
+    if (world.count(i) == 0) continue;
+    const Cell<2> o = cellOf<2>(grid.inCells<2>(origins[i]));
+    const Cell<2> a = cellOf<2>(grid.inCells<2>(world.boxes[i].min().cast<double>()));
+    const Cell<2> b = cellOf<2>(grid.inCells<2>(world.boxes[i].max().cast<double>()));
+    tiles.addPlaneBox({std::min({o[0], a[0], b[0]}), std::min({o[1], a[1], b[1]})},
+                      {std::max({o[0], a[0], b[0]}), std::max({o[1], a[1], b[1]})});
   }
+  SlotCounters hits(tiles.slots()), misses(tiles.slots());
+  struct Scratch {
+    EvidenceScratch evidence;
+    CellTiles::Lookup lookup;
+  };
+  parallelForWithScratch(
+      n, threads, 16, [&tiles] { return Scratch{{}, CellTiles::Lookup(tiles)}; },
+      [&](std::size_t i, Scratch& s) {
+        occupancyEvidence(
+            pointsOf(world, int(i)), origins[i], params, grid, planar, s.evidence,
+            [&](std::uint64_t key) { hits.increment(s.lookup.existingSlot(key)); },
+            [&](std::uint64_t key) { misses.increment(s.lookup.existingSlot(key)); });
+      });
+  std::vector<std::uint64_t> occupied;
+  for (std::size_t slot = 0; slot < tiles.slots(); ++slot)
+    if (hits.get(slot) > 0 && occupiedBy(hits.get(slot), misses.get(slot), params))
+      occupied.push_back(tiles.keyOfSlot(slot));
   return occupied;
 }
 
@@ -193,58 +177,100 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
 }
 
 /// Which observations hold each cell, and which cells each observation
-/// holds: cell c is held by watchers[cell_start[c], cell_start[c+1]);
-/// observation i's cells, ascending, are cells_of[offsets[i], offsets[i+1]).
+/// holds: cell c is held by watchers[cell_start[c], cell_start[c+1]) (in no
+/// particular order); observation i's cells are cells_of[offsets[i], offsets[i+1]).
 struct SharedCells {
   std::vector<std::size_t> offsets, cell_start;
   std::vector<std::uint32_t> watchers, cells_of;
 };
 
-/// Consumes `lists`: each observation's keys are freed once entered, so the
-/// regions are never held twice.
-SharedCells indexSharedCells(std::vector<std::vector<std::uint64_t>>& lists, int threads,
+/// One observation's cells: keys, ascending and distinct.
+struct KeySpan {
+  const std::uint64_t* begin = nullptr;
+  const std::uint64_t* end = nullptr;
+};
+
+/// Builds the index from keys_of(i) (a KeySpan for observation i) without
+/// sorting the entries: the cells are counted per tile slot, numbered, and
+/// each observation is written into its cells' lists. release(i) is called
+/// once observation i's keys are no longer needed, so that lists can be
+/// freed while the index grows. Four bytes per entry in each direction.
+template <typename KeysOf, typename Release>
+SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, Release&& release, int threads,
                              const InterruptFlag* interrupt) {
-  const int n = static_cast<int>(lists.size());
-  // Group the (cell, observation) entries by cell: one sort of all of them.
-  // Packed to 12 bytes: at 100,000 observations they are the largest array.
-#pragma pack(push, 4)
-  struct Entry {
-    std::uint64_t key;
-    std::uint32_t observation;
-    bool operator<(const Entry& other) const {
-      return key < other.key || (key == other.key && observation < other.observation);
-    }
-  };
-#pragma pack(pop)
   SharedCells shared;
-  shared.offsets = {0};
-  for (const auto& list : lists) shared.offsets.push_back(shared.offsets.back() + list.size());
-  std::vector<Entry> entries(shared.offsets.back());
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 64)
+  shared.offsets.reserve(std::size_t(n) + 1);
+  shared.offsets.push_back(0);
   for (int i = 0; i < n; ++i) {
-    for (std::size_t k = 0; k < lists[i].size(); ++k) entries[shared.offsets[i] + k] = {lists[i][k], std::uint32_t(i)};
-    std::vector<std::uint64_t>().swap(lists[i]);
+    const KeySpan keys = keys_of(i);
+    shared.offsets.push_back(shared.offsets.back() + std::size_t(keys.end - keys.begin));
+  }
+  // The tiles each observation touches, added in observation order.
+  CellTiles tiles(planar);
+  {
+    std::vector<std::vector<std::uint64_t>> tiles_of(n);
+    parallelFor(n, threads, 64, [&](std::size_t i) {
+      auto& touched = tiles_of[i];
+      const KeySpan keys = keys_of(int(i));
+      for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
+        const std::uint64_t tile = tiles.tileOf(*key);
+        if (touched.empty() || touched.back() != tile) touched.push_back(tile);
+      }
+      std::sort(touched.begin(), touched.end());
+      touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    });
+    for (auto& touched : tiles_of) {
+      for (std::uint64_t tile : touched) tiles.add(tile);
+      std::vector<std::uint64_t>().swap(touched);
+    }
   }
   throwIfInterrupted(interrupt);
-  sortInParallel(entries);  // distinct entries
+  SlotCounters watchers_of_slot(tiles.slots());
+  const auto with_lookup = [&tiles] { return CellTiles::Lookup(tiles); };
+  parallelForWithScratch(n, threads, 16, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+    const KeySpan keys = keys_of(int(i));
+    for (const std::uint64_t* key = keys.begin; key != keys.end; ++key)
+      watchers_of_slot.increment(lookup.existingSlot(*key));
+  });
   throwIfInterrupted(interrupt);
-  shared.watchers.resize(entries.size());
-  shared.cells_of.resize(entries.size());
-  std::vector<std::size_t> fill(shared.offsets.begin(), shared.offsets.end() - 1);
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    if (k == 0 || entries[k].key != entries[k - 1].key) shared.cell_start.push_back(k);
-    shared.watchers[k] = entries[k].observation;
-    shared.cells_of[fill[entries[k].observation]++] = std::uint32_t(shared.cell_start.size() - 1);
+  // Cells numbered in slot order; each slot's counter then counts the
+  // watchers written so far.
+  constexpr std::uint32_t kNoCell = ~std::uint32_t(0);
+  std::vector<std::uint32_t> cell_of_slot(tiles.slots(), kNoCell);
+  std::size_t total = 0;
+  for (std::size_t slot = 0; slot < tiles.slots(); ++slot) {
+    const std::uint32_t watchers = watchers_of_slot.get(slot);
+    if (watchers == 0) continue;
+    if (shared.cell_start.size() >= kNoCell) throw std::length_error("region overlap: more than 2^32 - 1 cells");
+    cell_of_slot[slot] = std::uint32_t(shared.cell_start.size());
+    shared.cell_start.push_back(total);
+    total += watchers;
+    watchers_of_slot.set(slot, 0);
   }
-  shared.cell_start.push_back(entries.size());
+  shared.cell_start.push_back(total);
+  shared.watchers.resize(total);
+  shared.cells_of.resize(total);
+  parallelForWithScratch(n, threads, 16, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+    const KeySpan keys = keys_of(int(i));
+    std::uint32_t* cells = shared.cells_of.data() + shared.offsets[i];
+    for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
+      const std::size_t slot = lookup.existingSlot(*key);
+      const std::uint32_t cell = cell_of_slot[slot];
+      *cells++ = cell;
+      shared.watchers[shared.cell_start[cell] + watchers_of_slot.increment(slot)] = std::uint32_t(i);
+    }
+    release(int(i));
+  });
+  throwIfInterrupted(interrupt);
   return shared;
 }
 
 /// For each observation, the other observations holding its cells and how
-/// many. Consumes `lists`.
-MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int threads, const InterruptFlag* interrupt) {
-  const int n = static_cast<int>(lists.size());
-  const SharedCells cells = indexSharedCells(lists, threads, interrupt);
+/// many: integer counts, the same whatever the order of a cell's watchers.
+template <typename KeysOf, typename Release>
+MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release, int threads,
+                        const InterruptFlag* interrupt) {
+  const SharedCells cells = indexSharedCells(n, planar, keys_of, release, threads, interrupt);
   MatchCounts out;
   out.rows.resize(n);
   std::uint64_t pairs = 0, tests = 0;
@@ -277,6 +303,14 @@ MatchCounts countShared(std::vector<std::vector<std::uint64_t>>& lists, int thre
   out.pairs_evaluated = pairs;
   out.point_tests = tests;
   return out;
+}
+
+/// countShared over per-observation lists, freeing each once indexed.
+MatchCounts countShared(RegionLists& lists, int threads, const InterruptFlag* interrupt) {
+  return countShared(
+      int(lists.cells.size()), lists.planar,
+      [&lists](int i) { return KeySpan{lists.cells[i].data(), lists.cells[i].data() + lists.cells[i].size()}; },
+      [&lists](int i) { std::vector<std::uint64_t>().swap(lists.cells[i]); }, threads, interrupt);
 }
 
 }  // namespace
@@ -317,7 +351,7 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
   RegionLists lists = regionLists(model, world, sensor_origins, params, threadCount(threads), interrupt);
   std::vector<std::size_t> sizes(lists.cells.size());
   for (std::size_t i = 0; i < sizes.size(); ++i) sizes[i] = lists.cells[i].size();
-  return assembleOverlap(countShared(lists.cells, threadCount(threads), interrupt), sizes);
+  return assembleOverlap(countShared(lists, threadCount(threads), interrupt), sizes);
 }
 
 
@@ -332,10 +366,11 @@ MatchCounts countSharedCells(const ObservationRegions& regions, int threads, con
       if (regions.cells[k] <= regions.cells[k - 1])
         throw std::invalid_argument("countSharedCells: the cells of observation " + std::to_string(i) +
                                     " must be ascending and distinct");
-  std::vector<std::vector<std::uint64_t>> lists(n);
-  for (int i = 0; i < n; ++i)
-    lists[i].assign(regions.cells.begin() + regions.offsets[i], regions.cells.begin() + regions.offsets[i + 1]);
-  return countShared(lists, threads, interrupt);
+  const std::uint64_t* cells = regions.cells.data();
+  return countShared(
+      n, regions.planar,
+      [&](int i) { return KeySpan{cells + regions.offsets[i], cells + regions.offsets[i + 1]}; }, [](int) {}, threads,
+      interrupt);
 }
 
 OverlapResult regionOverlap(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
