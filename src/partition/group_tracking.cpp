@@ -97,12 +97,18 @@ Partition partitionAroundChanges(const WeightMatrix& W, const std::vector<int>& 
   for (int g : region_groups)
     for (int id : current.groups().at(g))
       if (present(id)) in_region[position(id)] = 1;
-  // ...and the groups next to them.
+  // ...and the groups the changed and new observations overlap. Not the
+  // groups next to the whole region: where observations see far (a lab whose
+  // corridor looks into every room), that is most of the map.
   std::set<int> next_to;
+  const auto add_neighbours = [&](std::size_t k) {
+    for (WeightMatrix::InnerIterator it(W, Eigen::Index(k)); it; ++it)
+      if (!in_region[it.row()] && current.groupOf(ids[it.row()]) >= 0) next_to.insert(current.groupOf(ids[it.row()]));
+  };
+  for (int id : changed_ids)
+    if (present(id)) add_neighbours(std::size_t(position(id)));
   for (std::size_t k = 0; k < ids.size(); ++k)
-    if (in_region[k])
-      for (WeightMatrix::InnerIterator it(W, Eigen::Index(k)); it; ++it)
-        if (!in_region[it.row()] && current.groupOf(ids[it.row()]) >= 0) next_to.insert(current.groupOf(ids[it.row()]));
+    if (current.groupOf(ids[k]) < 0) add_neighbours(k);
   for (int g : next_to)
     for (int id : current.groups().at(g))
       if (present(id)) in_region[position(id)] = 1;

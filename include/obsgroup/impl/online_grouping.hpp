@@ -66,6 +66,7 @@ int OnlineGrouping<PointT>::insert(const PointCloudConstPtr& cloud, const Eigen:
   }
   slots_.push_back({true, observation});
   ++changes_since_exact_;
+  moved_.push_back(id);
   origin_ = origin;
   overlap_->set(id, std::move(points), pose.translation() - origin);
   return id;
@@ -78,6 +79,7 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
   Observation<PointT> moved = slots_[id].observation;
   moved.pose = pose;
   ++changes_since_exact_;
+  moved_.push_back(id);
   if (id == firstPresent()) {
     // The common frame moves with it: every observation is re-centred.
     const Observation<PointT> kept = slots_[id].observation;
@@ -121,6 +123,7 @@ void OnlineGrouping<PointT>::remove(int id) {
     }
   }
   ++changes_since_exact_;
+  moved_.push_back(id);
   slots_[id].observation = Observation<PointT>{};
 }
 
@@ -175,7 +178,7 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   if (out.exact) {
     groups = partitionExactly(ids, out);
   } else {
-    partition_ = partitionAroundChanges(W_, ids, changed_slots, group_ids_, getPartitionOptions());
+    partition_ = partitionAroundChanges(W_, ids, moved_, group_ids_, getPartitionOptions());
     for (const auto& group : partition_.groups) {
       std::vector<int> members;
       for (int k : group) members.push_back(ids[k]);
@@ -190,6 +193,7 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
                           " has no finite point: it overlaps nothing and forms a group of its own");
   warnings_.insert(warnings_.end(), partition_.warnings.begin(), partition_.warnings.end());
   out.changes = group_ids_.assign(groups, slots_.size());
+  moved_.clear();
   return out;
 }
 

@@ -81,9 +81,10 @@ class StableGroupIds {
 };
 
 /// The local update of OnlineGrouping::setExactInterval: the groups of
-/// `current` holding an observation of `changed_ids`, the observations in no
-/// group yet and the groups next to them in W are re-partitioned on their
-/// own (with `options`); the other groups are kept. W is over the positions
+/// `current` holding an observation of `changed_ids` (those inserted, moved or
+/// removed), the observations in no group yet and the groups these
+/// observations overlap in W are re-partitioned on their own (with
+/// `options`); the other groups are kept. W is over the positions
 /// of `ids` (the observation ids present, ascending). The partition returned
 /// is over those positions, with no split tree.
 Partition partitionAroundChanges(const WeightMatrix& W, const std::vector<int>& ids,
