@@ -8,6 +8,10 @@
 
 #include <omp.h>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,6 +27,18 @@ namespace obsgroup {
 namespace {
 
 using namespace region_cells;
+
+/// Hands the pages of `bytes` of small blocks just freed (the regions' lists:
+/// a few kilobytes each, kept by malloc for reuse) back to the system, so
+/// that they do not add to every later stage's resident memory. Only for
+/// large amounts: trimming walks the heap.
+void returnFreedMemory(std::size_t bytes) {
+#if defined(__GLIBC__)
+  if (bytes >= (std::size_t(64) << 20)) malloc_trim(0);
+#else
+  (void)bytes;
+#endif
+}
 
 /// The plane cells occupied in the evidence of all observations: at least
 /// params.min_observations observations have a point in the cell, and at
@@ -307,10 +323,14 @@ MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release,
 
 /// countShared over per-observation lists, freeing each once indexed.
 MatchCounts countShared(RegionLists& lists, int threads, const InterruptFlag* interrupt) {
-  return countShared(
+  std::size_t bytes = 0;
+  for (const auto& list : lists.cells) bytes += list.size() * sizeof(std::uint64_t);
+  MatchCounts counts = countShared(
       int(lists.cells.size()), lists.planar,
       [&lists](int i) { return KeySpan{lists.cells[i].data(), lists.cells[i].data() + lists.cells[i].size()}; },
       [&lists](int i) { std::vector<std::uint64_t>().swap(lists.cells[i]); }, threads, interrupt);
+  returnFreedMemory(bytes);
+  return counts;
 }
 
 }  // namespace
@@ -342,6 +362,7 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
     regions.cells.insert(regions.cells.end(), list.begin(), list.end());
     std::vector<std::uint64_t>().swap(list);
   }
+  returnFreedMemory(regions.cells.size() * sizeof(std::uint64_t));
   return regions;
 }
 
