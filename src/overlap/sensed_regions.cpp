@@ -32,9 +32,10 @@ using namespace region_cells;
 /// a few kilobytes each, kept by malloc for reuse) back to the system, so
 /// that they do not add to every later stage's resident memory. Only for
 /// large amounts: trimming walks the heap.
+constexpr std::size_t kTrimBytes = std::size_t(64) << 20;
 void returnFreedMemory(std::size_t bytes) {
 #if defined(__GLIBC__)
-  if (bytes >= (std::size_t(64) << 20)) malloc_trim(0);
+  if (bytes >= kTrimBytes) malloc_trim(0);
 #else
   (void)bytes;
 #endif
@@ -192,12 +193,15 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   return regions;
 }
 
-/// Which observations hold each cell, and which cells each observation
-/// holds: cell c is held by watchers[cell_start[c], cell_start[c+1]) (in no
-/// particular order); observation i's cells are cells_of[offsets[i], offsets[i+1]).
+/// Which observations hold each cell: cell c is held by
+/// watchers[cell_start[c], cell_start[c+1]) (in no particular order); the
+/// cell of a key is cell_of_slot[its slot in tiles].
 struct SharedCells {
-  std::vector<std::size_t> offsets, cell_start;
-  std::vector<std::uint32_t> watchers, cells_of;
+  explicit SharedCells(bool planar) : tiles(planar) {}
+  CellTiles tiles;
+  std::vector<std::uint32_t> cell_of_slot;
+  std::vector<std::size_t> cell_start;
+  std::vector<std::uint32_t> watchers;
 };
 
 /// One observation's cells: keys, ascending and distinct.
@@ -208,21 +212,12 @@ struct KeySpan {
 
 /// Builds the index from keys_of(i) (a KeySpan for observation i) without
 /// sorting the entries: the cells are counted per tile slot, numbered, and
-/// each observation is written into its cells' lists. release(i) is called
-/// once observation i's keys are no longer needed, so that lists can be
-/// freed while the index grows. Four bytes per entry in each direction.
-template <typename KeysOf, typename Release>
-SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, Release&& release, int threads,
-                             const InterruptFlag* interrupt) {
-  SharedCells shared;
-  shared.offsets.reserve(std::size_t(n) + 1);
-  shared.offsets.push_back(0);
-  for (int i = 0; i < n; ++i) {
-    const KeySpan keys = keys_of(i);
-    shared.offsets.push_back(shared.offsets.back() + std::size_t(keys.end - keys.begin));
-  }
+/// each observation is written into its cells' lists. Four bytes per entry.
+template <typename KeysOf>
+SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, const InterruptFlag* interrupt) {
+  SharedCells shared(planar);
+  CellTiles& tiles = shared.tiles;
   // The tiles each observation touches, added in observation order.
-  CellTiles tiles(planar);
   {
     std::vector<std::vector<std::uint64_t>> tiles_of(n);
     parallelFor(n, threads, 64, [&](std::size_t i) {
@@ -252,30 +247,26 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, Release&& rel
   // Cells numbered in slot order; each slot's counter then counts the
   // watchers written so far.
   constexpr std::uint32_t kNoCell = ~std::uint32_t(0);
-  std::vector<std::uint32_t> cell_of_slot(tiles.slots(), kNoCell);
+  shared.cell_of_slot.assign(tiles.slots(), kNoCell);
   std::size_t total = 0;
   for (std::size_t slot = 0; slot < tiles.slots(); ++slot) {
     const std::uint32_t watchers = watchers_of_slot.get(slot);
     if (watchers == 0) continue;
     if (shared.cell_start.size() >= kNoCell) throw std::length_error("region overlap: more than 2^32 - 1 cells");
-    cell_of_slot[slot] = std::uint32_t(shared.cell_start.size());
+    shared.cell_of_slot[slot] = std::uint32_t(shared.cell_start.size());
     shared.cell_start.push_back(total);
     total += watchers;
     watchers_of_slot.set(slot, 0);
   }
   shared.cell_start.push_back(total);
   shared.watchers.resize(total);
-  shared.cells_of.resize(total);
   parallelForWithScratch(n, threads, 16, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
     const KeySpan keys = keys_of(int(i));
-    std::uint32_t* cells = shared.cells_of.data() + shared.offsets[i];
     for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
       const std::size_t slot = lookup.existingSlot(*key);
-      const std::uint32_t cell = cell_of_slot[slot];
-      *cells++ = cell;
-      shared.watchers[shared.cell_start[cell] + watchers_of_slot.increment(slot)] = std::uint32_t(i);
+      shared.watchers[shared.cell_start[shared.cell_of_slot[slot]] + watchers_of_slot.increment(slot)] =
+          std::uint32_t(i);
     }
-    release(int(i));
   });
   throwIfInterrupted(interrupt);
   return shared;
@@ -283,10 +274,12 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, Release&& rel
 
 /// For each observation, the other observations holding its cells and how
 /// many: integer counts, the same whatever the order of a cell's watchers.
+/// release(i) is called once observation i's keys are no longer needed, so
+/// that lists can be freed as the rows are counted.
 template <typename KeysOf, typename Release>
 MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release, int threads,
                         const InterruptFlag* interrupt) {
-  const SharedCells cells = indexSharedCells(n, planar, keys_of, release, threads, interrupt);
+  const SharedCells cells = indexSharedCells(n, planar, keys_of, threads, interrupt);
   MatchCounts out;
   out.rows.resize(n);
   std::uint64_t pairs = 0, tests = 0;
@@ -294,17 +287,21 @@ MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release,
   {
     std::vector<std::uint32_t> shared(n, 0);
     std::vector<int> touched;
+    CellTiles::Lookup lookup(cells.tiles);
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
       if (interruptRequested(interrupt)) continue;
-      for (std::size_t k = cells.offsets[i]; k < cells.offsets[i + 1]; ++k) {
-        const std::uint32_t c = cells.cells_of[k];
+      const KeySpan keys = keys_of(i);
+      for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
+        // The slot exists: indexSharedCells added it for this very key.
+        const std::uint32_t c = cells.cell_of_slot[lookup.slot(*key)];
         for (std::size_t w = cells.cell_start[c]; w < cells.cell_start[c + 1]; ++w) {
           const std::uint32_t j = cells.watchers[w];
           if (shared[j]++ == 0) touched.push_back(int(j));
         }
         tests += cells.cell_start[c + 1] - cells.cell_start[c];
       }
+      release(i);
       std::sort(touched.begin(), touched.end());
       auto& row = out.rows[i];
       for (int j : touched) {
@@ -358,11 +355,19 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   regions.phase = lists.phase;
   for (const auto& list : lists.cells) regions.offsets.push_back(regions.offsets.back() + list.size());
   regions.cells.reserve(regions.offsets.back());
+  // The lists are handed back as they are copied, so that the regions are
+  // not resident twice at the end.
+  std::size_t freed = 0;
   for (auto& list : lists.cells) {
     regions.cells.insert(regions.cells.end(), list.begin(), list.end());
+    freed += list.size() * sizeof(std::uint64_t);
     std::vector<std::uint64_t>().swap(list);
+    if (freed >= kTrimBytes) {
+      returnFreedMemory(freed);
+      freed = 0;
+    }
   }
-  returnFreedMemory(regions.cells.size() * sizeof(std::uint64_t));
+  returnFreedMemory(freed);
   return regions;
 }
 
