@@ -146,24 +146,35 @@ std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, con
   return std::move(crossed[0]);
 }
 
-/// The grid cell of every region cell (regions.cells' order; 3D voxels
-/// fall on the cell below them).
-std::vector<std::uint32_t> gridCellsOfRegions(const ObservationRegions& regions, const GridFrame& f) {
-  std::vector<std::uint32_t> index(regions.cells.size());
-  parallelFor(std::size_t(regions.size()), 0, 16, [&](std::size_t i) {
-    for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
-      const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
-      index[k] = std::uint32_t(*f.indexOf(c.x(), c.y()));  // the grid holds every region cell
-    }
-  });
-  return index;
-}
+/// The grid cell of a region cell's key (3D voxels fall on the cell below
+/// them), from the key's integer coordinates: the grid's cell edges are the
+/// regions' (makeGrid), so a cell's offset from the first region cell is its
+/// offset in the grid. No index per region cell is stored.
+class FloorCellOfKey {
+ public:
+  FloorCellOfKey(const ObservationRegions& regions, const GridFrame& f)
+      : x_shift_(regions.planar ? 32 : 42), y_shift_(regions.planar ? 0 : 21),
+        y_mask_(regions.planar ? 0xffffffffu : (std::uint64_t(1) << 21) - 1), grid_(f.grid) {
+    const std::uint64_t first = regions.cells.empty() ? 0 : regions.cells.front();
+    x0_ = std::int64_t(first >> x_shift_) + f.first.x();
+    y0_ = std::int64_t((first >> y_shift_) & y_mask_) + f.first.y();
+  }
+  std::size_t operator()(std::uint64_t key) const {
+    return grid_.index(int(std::int64_t(key >> x_shift_) - x0_), int(std::int64_t((key >> y_shift_) & y_mask_) - y0_));
+  }
+
+ private:
+  int x_shift_, y_shift_;
+  std::uint64_t y_mask_;
+  const FloorGrid& grid_;
+  std::int64_t x0_ = 0, y0_ = 0;
+};
 
 /// Per floor cell, the group the largest share of whose observations hold
 /// it (ties: the lower group), or kNone. Groups are taken in order, each
 /// counting its observations per cell once (a 3D region's voxels above one
 /// cell count once), so no sort of all the cells is needed.
-std::vector<int> ownerOfCells(const ObservationRegions& regions, const std::vector<std::uint32_t>& cell_of,
+std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCellOfKey& cell_of,
                               const std::vector<std::vector<int>>& groups, const std::vector<Occupancy>& occupancy) {
   const std::size_t cells = occupancy.size();
   std::vector<int> owner(cells, kNone);
@@ -175,10 +186,10 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const std::vect
     for (int i : groups[g]) {
       ++stamp;
       for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
-        const std::uint32_t c = cell_of[k];
+        const std::size_t c = cell_of(regions.cells[k]);
         if (seen_by[c] == stamp) continue;  // another voxel of this observation above the cell
         seen_by[c] = stamp;
-        if (count[c]++ == 0) touched.push_back(c);
+        if (count[c]++ == 0) touched.push_back(std::uint32_t(c));
       }
     }
     const std::uint64_t size = groups[g].size();
@@ -598,10 +609,10 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   // Floor is what a beam crossed and a region holds: a region model may
   // reach where no beam went (visibility all around a forward sensor).
   const std::vector<char> crossed = crossedCells(f, world, sensor_origins);
-  const std::vector<std::uint32_t> cell_of = gridCellsOfRegions(regions, f);
+  const FloorCellOfKey cell_of(regions, f);
   map.occupancy.assign(cells, Occupancy::Unknown);
-  for (std::uint32_t k : cell_of)
-    if (crossed[k]) map.occupancy[k] = Occupancy::Free;
+  for (std::uint64_t key : regions.cells)
+    if (const std::size_t k = cell_of(key); crossed[k]) map.occupancy[k] = Occupancy::Free;
   for (int i = 0; i < n; ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
       if (isObstacle(*p, sensor_origins[i], planar, options))
