@@ -55,8 +55,9 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
   const obsgroup::ObservationRegions& regions = grouping.getRegions();
   rows.push_back({"region cells (8 B a cell of a region)", capacityBytes(regions.cells) + capacityBytes(regions.offsets),
                   "overlap, places"});
-  // countSharedCells' index: a cell number and a watcher per region cell, a start per distinct cell.
-  rows.push_back({"shared-cell index (4 + 4 B a cell of a region)", 8.0 * double(regions.cells.size()), "overlap"});
+  // countSharedCells' index: a watcher per region cell (its start per distinct cell and its tile
+  // slots, a few per cent more, are left out).
+  rows.push_back({"shared-cell index (4 B a cell of a region)", 4.0 * double(regions.cells.size()), "overlap"});
   const obsgroup::OverlapResult& overlap = grouping.getOverlap();
   rows.push_back({"Pi and the pairs of Psi", double(overlap.match_ratio.nonZeros()) * (sizeof(double) + sizeof(int)) +
                                                  capacityBytes(overlap.pairs),
