@@ -32,6 +32,11 @@ using namespace region_cells;
 /// a few kilobytes each, kept by malloc for reuse) back to the system, so
 /// that they do not add to every later stage's resident memory. Only for
 /// large amounts: trimming walks the heap.
+/// Observations per chunk of the loops that add to shared counters: threads
+/// then work on observations far apart along the route, not on the same
+/// cells' cache lines.
+constexpr int kCountingChunk = 256;
+
 constexpr std::size_t kTrimBytes = std::size_t(64) << 20;
 void returnFreedMemory(std::size_t bytes) {
 #if defined(__GLIBC__)
@@ -68,7 +73,7 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
     CellTiles::Lookup lookup;
   };
   parallelForWithScratch(
-      n, threads, 16, [&tiles] { return Scratch{{}, CellTiles::Lookup(tiles)}; },
+      n, threads, kCountingChunk, [&tiles] { return Scratch{{}, CellTiles::Lookup(tiles)}; },
       [&](std::size_t i, Scratch& s) {
         occupancyEvidence(
             pointsOf(world, int(i)), origins[i], params, grid, planar, s.evidence,
@@ -238,7 +243,7 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   throwIfInterrupted(interrupt);
   SlotCounters watchers_of_slot(tiles.slots());
   const auto with_lookup = [&tiles] { return CellTiles::Lookup(tiles); };
-  parallelForWithScratch(n, threads, 16, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+  parallelForWithScratch(n, threads, kCountingChunk, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
     const KeySpan keys = keys_of(int(i));
     for (const std::uint64_t* key = keys.begin; key != keys.end; ++key)
       watchers_of_slot.increment(lookup.existingSlot(*key));
@@ -260,7 +265,7 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   }
   shared.cell_start.push_back(total);
   shared.watchers.resize(total);
-  parallelForWithScratch(n, threads, 16, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+  parallelForWithScratch(n, threads, kCountingChunk, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
     const KeySpan keys = keys_of(int(i));
     for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
       const std::size_t slot = lookup.existingSlot(*key);
