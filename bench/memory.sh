@@ -37,9 +37,9 @@ import json, os, statistics, subprocess, sys, time
 work, repeats = sys.argv[1], int(sys.argv[2])
 exe = os.path.join(work, "obsgroup-memory")
 stages = ["load", "overlap", "graph", "partition", "local_maps", "places", "outputs"]
-print(f"`obsgroup partition --no-pictures`, default settings, medians of {repeats} runs (`outputs` includes `places`):")
+print(f"`obsgroup partition --no-pictures`, default settings, the run of median wall time of {repeats} (peak RSS: the largest of the runs; `outputs` includes `places`):")
 print()
-print("| scans | wall s | peak RSS MiB | " + " | ".join(f"{s} s" for s in stages) + " | groups |")
+print("| scans | wall s | peak RSS MiB, max | " + " | ".join(f"{s} s" for s in stages) + " | groups |")
 print("|---" * (len(stages) + 4) + "|")
 for n in (10010, 100100):
     runs = []

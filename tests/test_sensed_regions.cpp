@@ -629,6 +629,65 @@ TEST(SensedRegions, SharedCellsOfHandMadeRegions) {
   }
 }
 
+// Random regions of plane cells and of voxels, around the origin (negative
+// cell indices) and across tile borders (64 cells, 16 voxels), counted
+// against a brute-force intersection of every pair, with 1 and 3 threads.
+TEST(SensedRegions, SharedCellsMatchABruteForceCountAcrossTilesIn2DAnd3D) {
+  std::mt19937 rng(7);
+  for (const bool planar : {true, false}) {
+    const auto key = [planar](std::int64_t x, std::int64_t y, std::int64_t z) {
+      if (planar) return (std::uint64_t(x + (std::int64_t(1) << 31)) << 32) | std::uint64_t(y + (std::int64_t(1) << 31));
+      const std::int64_t bias = std::int64_t(1) << 20;
+      return (std::uint64_t(x + bias) << 42) | (std::uint64_t(y + bias) << 21) | std::uint64_t(z + bias);
+    };
+    const int n = 40;
+    std::vector<std::set<std::uint64_t>> cells(n);
+    std::uniform_int_distribution<int> centre(-80, 80), size(0, 300), offset(-12, 12);
+    for (auto& region : cells) {
+      const int cx = centre(rng), cy = centre(rng), cz = planar ? 0 : centre(rng) / 4, count = size(rng);
+      for (int k = 0; k < count; ++k)
+        region.insert(key(cx + offset(rng), cy + offset(rng), planar ? 0 : cz + offset(rng) / 3));
+    }
+    ObservationRegions regions;
+    regions.planar = planar;
+    for (const auto& region : cells) {
+      regions.cells.insert(regions.cells.end(), region.begin(), region.end());
+      regions.offsets.push_back(regions.cells.size());
+    }
+    for (const int threads : {1, 3}) {
+      const MatchCounts counts = countSharedCells(regions, threads);
+      ASSERT_EQ(counts.rows.size(), std::size_t(n));
+      for (int i = 0; i < n; ++i) {
+        std::vector<std::pair<int, std::uint32_t>> expected, got;
+        for (int j = 0; j < n; ++j) {
+          if (j == i) continue;
+          std::uint32_t shared = 0;
+          for (std::uint64_t c : cells[i]) shared += cells[j].count(c) ? 1 : 0;
+          if (shared > 0) expected.emplace_back(j, shared);
+        }
+        for (const MatchCount& m : counts.rows[i]) got.emplace_back(m.j, m.count);
+        EXPECT_EQ(got, expected) << (planar ? "plane cells" : "voxels") << ", observation " << i << ", threads "
+                                 << threads;
+      }
+    }
+  }
+}
+
+// A far return (one point kilometres away) changes no region and no overlap:
+// occupancy evidence is tallied only where it lies, not over the box between.
+TEST(SensedRegions, AFarReturnChangesNothingNearby) {
+  const auto scans = obsgroup::test::realLog(30);
+  std::vector<Observation<pcl::PointXYZ>> far = scans;
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*far[3].cloud);
+  cloud->push_back(pcl::PointXYZ(4000.0f, -3000.0f, 0.0f));
+  far[3].cloud = cloud;
+  SensedSpaceOverlap<pcl::PointXYZ> overlap;
+  overlap.setSensedSpaceModel(SensedSpaceModel::Visibility);
+  const OverlapResult near_only = overlap.compute(scans), with_far = overlap.compute(far);
+  EXPECT_EQ(with_far.region_cells, near_only.region_cells);
+  EXPECT_EQ(Eigen::MatrixXd(with_far.match_ratio), Eigen::MatrixXd(near_only.match_ratio));
+}
+
 // --- 11. the office with drift -----------------------------------------------
 
 // The judged case of the grouping issue: a forward laser with drifted poses

@@ -75,10 +75,12 @@ class OnlineGrouping {
   GroupUpdate updateExact();
 
   /// An approximation for speed, off by default (1: every update() is
-  /// exact). With n > 1, update() re-partitions only the groups that hold a
-  /// changed observation, the new observations and the groups next to them
-  /// in W, and leaves the other groups as they are; it is exact again once n
-  /// observations were inserted or moved since the last exact update. The
+  /// exact). With n > 1, update() re-partitions only the groups that hold an
+  /// observation inserted, moved or removed since the last update, the new
+  /// observations and the groups these observations overlap in W, and leaves
+  /// the other groups as they are; it is exact again once n observations were
+  /// inserted or moved since the last exact update, and after a change of the
+  /// common frame (the first observation moved or removed). The
   /// overlaps (W) stay exact. A local update's partition has no split tree
   /// (Partition::splits is empty). docs/performance.md measures how far its
   /// groups drift from the exact ones.

@@ -40,14 +40,6 @@ class CellTiles {
     if (index_.emplace(tile, std::uint32_t(tiles_.size())).second) tiles_.push_back(tile);
   }
 
-  /// Adds every plane tile holding a cell of the box [lo, hi] (cells).
-  void addPlaneBox(const Cell<2>& lo, const Cell<2>& hi) {
-    const std::int64_t x0 = (lo[0] + kBias2) >> 6, x1 = (hi[0] + kBias2) >> 6;
-    const std::int64_t y0 = (lo[1] + kBias2) >> 6, y1 = (hi[1] + kBias2) >> 6;
-    for (std::int64_t x = x0; x <= x1; ++x)
-      for (std::int64_t y = y0; y <= y1; ++y) add(std::uint64_t(x) << 32 | std::uint64_t(y));
-  }
-
   std::size_t tiles() const { return tiles_.size(); }
   std::size_t slots() const { return tiles_.size() * kCellsPerTile; }
 

@@ -28,15 +28,16 @@ namespace {
 
 using namespace region_cells;
 
+/// Observations per chunk of the loops that add to shared counters: long
+/// runs of consecutive observations, so that the threads count cells far
+/// apart along the route rather than the same cache lines, but at least
+/// eight chunks a thread to share the work.
+int countingChunk(int n, int threads) { return std::max(16, std::min(256, n / (8 * std::max(1, threads)))); }
+
 /// Hands the pages of `bytes` of small blocks just freed (the regions' lists:
 /// a few kilobytes each, kept by malloc for reuse) back to the system, so
 /// that they do not add to every later stage's resident memory. Only for
 /// large amounts: trimming walks the heap.
-/// Observations per chunk of the loops that add to shared counters: threads
-/// then work on observations far apart along the route, not on the same
-/// cells' cache lines.
-constexpr int kCountingChunk = 256;
-
 constexpr std::size_t kTrimBytes = std::size_t(64) << 20;
 void returnFreedMemory(std::size_t bytes) {
 #if defined(__GLIBC__)
@@ -56,16 +57,33 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
                                          const RegionParameters& params, const CellGrid& grid, bool planar,
                                          int threads) {
   const int n = world.size();
-  // An observation's evidence lies in the box of its sensor and its points
-  // (its beams are clipped towards the sensor): those tiles are added first.
+  // An observation's evidence lies in the cells of its points (in the band)
+  // and, for the beams clipped to the range, in the box within range of its
+  // sensor: those tiles are added first, in observation order. Not the box
+  // of all its points: one far return would add every tile between.
   CellTiles tiles(true);
-  for (int i = 0; i < n; ++i) {
-    if (world.count(i) == 0) continue;
-    const Cell<2> o = cellOf<2>(grid.inCells<2>(origins[i]));
-    const Cell<2> a = cellOf<2>(grid.inCells<2>(world.boxes[i].min().cast<double>()));
-    const Cell<2> b = cellOf<2>(grid.inCells<2>(world.boxes[i].max().cast<double>()));
-    tiles.addPlaneBox({std::min({o[0], a[0], b[0]}), std::min({o[1], a[1], b[1]})},
-                      {std::max({o[0], a[0], b[0]}), std::max({o[1], a[1], b[1]})});
+  {
+    std::vector<std::vector<std::uint64_t>> tiles_of(n);
+    parallelFor(n, threads, 16, [&](std::size_t i) {
+      const PointSpan points = pointsOf(world, int(i));
+      if (points.empty()) return;
+      auto& touched = tiles_of[i];
+      const auto [lo, hi] = boxAround<2>(grid.inCells<2>(origins[i]), params.max_range / grid.size);
+      for (std::int64_t x = (lo[0] + kBias2) >> 6; x <= (hi[0] + kBias2) >> 6; ++x)
+        for (std::int64_t y = (lo[1] + kBias2) >> 6; y <= (hi[1] + kBias2) >> 6; ++y)
+          touched.push_back(std::uint64_t(x) << 32 | std::uint64_t(y));
+      for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p)
+        if (inBand(*p, origins[i], params, planar)) {
+          const std::uint64_t tile = tiles.tileOf(keyOf<2>(cellOf<2>(grid.inCells<2>(p->cast<double>()))));
+          if (touched.back() != tile) touched.push_back(tile);
+        }
+      std::sort(touched.begin(), touched.end());
+      touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    });
+    for (auto& touched : tiles_of) {
+      for (std::uint64_t tile : touched) tiles.add(tile);
+      std::vector<std::uint64_t>().swap(touched);
+    }
   }
   SlotCounters hits(tiles.slots()), misses(tiles.slots());
   struct Scratch {
@@ -73,7 +91,7 @@ std::vector<std::uint64_t> occupiedCells(const WorldPoints& world, const std::ve
     CellTiles::Lookup lookup;
   };
   parallelForWithScratch(
-      n, threads, kCountingChunk, [&tiles] { return Scratch{{}, CellTiles::Lookup(tiles)}; },
+      n, threads, countingChunk(n, threads), [&tiles] { return Scratch{{}, CellTiles::Lookup(tiles)}; },
       [&](std::size_t i, Scratch& s) {
         occupancyEvidence(
             pointsOf(world, int(i)), origins[i], params, grid, planar, s.evidence,
@@ -243,7 +261,7 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   throwIfInterrupted(interrupt);
   SlotCounters watchers_of_slot(tiles.slots());
   const auto with_lookup = [&tiles] { return CellTiles::Lookup(tiles); };
-  parallelForWithScratch(n, threads, kCountingChunk, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+  parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
     const KeySpan keys = keys_of(int(i));
     for (const std::uint64_t* key = keys.begin; key != keys.end; ++key)
       watchers_of_slot.increment(lookup.existingSlot(*key));
@@ -265,7 +283,7 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   }
   shared.cell_start.push_back(total);
   shared.watchers.resize(total);
-  parallelForWithScratch(n, threads, kCountingChunk, with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
+  parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
     const KeySpan keys = keys_of(int(i));
     for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
       const std::size_t slot = lookup.existingSlot(*key);

@@ -79,7 +79,6 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
   Observation<PointT> moved = slots_[id].observation;
   moved.pose = pose;
   ++changes_since_exact_;
-  moved_.push_back(id);
   if (id == firstPresent()) {
     // The common frame moves with it: every observation is re-centred.
     const Observation<PointT> kept = slots_[id].observation;
@@ -91,6 +90,7 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
       recentreAll();
       throw;
     }
+    moved_.push_back(id);
     return;
   }
   if (!overlap_ || reconfigure_) recentreAll();
@@ -102,6 +102,7 @@ void OnlineGrouping<PointT>::updatePose(int id, const Eigen::Isometry3d& pose) {
   }
   overlap_->set(id, std::move(points), pose.translation() - origin_);
   slots_[id].observation = moved;
+  moved_.push_back(id);
 }
 
 template <typename PointT>
@@ -129,6 +130,9 @@ void OnlineGrouping<PointT>::remove(int id) {
 
 template <typename PointT>
 void OnlineGrouping<PointT>::recentreAll() {
+  // A new common frame moves the cell grid under every region: all of W may
+  // change, so the next update is exact, not local.
+  exact_once_ = false;
   const int first = firstPresent();
   const Eigen::Vector3d origin =
       first >= 0 ? Eigen::Vector3d(slots_[first].observation.pose.translation()) : Eigen::Vector3d::Zero();
