@@ -280,6 +280,61 @@ TEST(OnlineGrouping, LocalUpdatesBetweenExactOnes) {
   expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "updateExact");
 }
 
+// Local updates around removals and moves: the group an observation left is
+// re-partitioned, every observation stays in exactly one group, groups far
+// from the change keep their members, and moving the first observation (a
+// new common frame) makes the next update exact.
+TEST(OnlineGrouping, LocalUpdatesAroundRemovalsAndMoves) {
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setExactInterval(1000);
+  for (const auto& o : obs) online.insert(o.cloud, o.pose);
+  ASSERT_TRUE(online.update().exact);  // the first update is exact
+  const auto everyone_once = [&online](const std::string& when) {
+    std::vector<int> seen;
+    for (const auto& [group, members] : online.getGroups()) seen.insert(seen.end(), members.begin(), members.end());
+    std::sort(seen.begin(), seen.end());
+    EXPECT_EQ(seen, online.getIds()) << when;
+  };
+
+  // Remove one observation: a local update; the groups that do not hold it
+  // and do not overlap it keep their members.
+  const int removed = 40;
+  int home = -1;
+  for (const auto& [group, members] : online.getGroups())
+    if (std::find(members.begin(), members.end(), removed) != members.end()) home = group;
+  ASSERT_GE(home, 0);
+  const auto before = online.getGroups();
+  const WeightMatrix W = online.getWeightMatrix();
+  std::set<int> touching{home};
+  for (WeightMatrix::InnerIterator it(W, removed); it; ++it)
+    for (const auto& [group, members] : before)
+      if (std::find(members.begin(), members.end(), int(it.row())) != members.end()) touching.insert(group);
+  online.remove(removed);
+  EXPECT_FALSE(online.update().exact);
+  everyone_once("after the removal");
+  const auto after = online.getGroups();
+  for (const auto& [group, members] : before) {
+    if (touching.count(group)) continue;
+    ASSERT_TRUE(after.count(group)) << "group " << group << " far from the removal lost its id";
+    EXPECT_EQ(after.at(group), members) << "group " << group << " far from the removal changed";
+  }
+
+  // Move an observation a little: local again.
+  Eigen::Isometry3d moved = obs[10].pose;
+  moved.translation().x() += 0.05;
+  online.updatePose(10, moved);
+  EXPECT_FALSE(online.update().exact);
+  everyone_once("after a move");
+
+  // Move the first observation: the common frame changes, the update is exact.
+  Eigen::Isometry3d first = obs[0].pose;
+  first.translation().y() += 0.05;
+  online.updatePose(0, first);
+  EXPECT_TRUE(online.update().exact);
+  expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "after moving the first observation");
+}
+
 TEST(OnlineGrouping, SameResultWhateverTheThreadCount) {
   const auto obs = driftedOffice(50);
   std::vector<std::map<int, std::vector<int>>> groups;
