@@ -210,10 +210,10 @@ struct Configuration {
   /// Every parameter, for the summary line of a sweep.
   std::string parameters() const {
     return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
-                  "min-group-size=%d ncut-threshold=%g boundary-passes=%d",
+                  "door-width=%g door-depth=%g min-group-size=%d ncut-threshold=%g boundary-passes=%d",
                   toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
                   region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
-                  min_group_size, ncut_threshold, boundary_passes);
+                  region.door_width, region.door_depth, min_group_size, ncut_threshold, boundary_passes);
   }
 };
 
@@ -506,6 +506,8 @@ std::string sweepTable(const std::vector<Dataset>& datasets, const std::vector<L
       {"cell (m)", [](Configuration& c) -> double& { return c.region.cell_size; }},
       {"range (m)", [](Configuration& c) -> double& { return c.region.max_range; }},
       {"clearance (m)", [](Configuration& c) -> double& { return c.region.clearance; }},
+      {"door width (m)", [](Configuration& c) -> double& { return c.region.door_width; }},
+      {"door depth (m)", [](Configuration& c) -> double& { return c.region.door_depth; }},
   };
   const SweepPoint reference = sweepPoint(datasets, logs, base);
   const auto change = [](int value, int of) {
@@ -556,7 +558,8 @@ std::string page(const std::vector<Dataset>& datasets, const std::vector<Configu
   out << "Parameters of every row: δ " << common.match_distance << " m (points); cell " << common.region.cell_size
       << " m, range " << common.region.max_range << " m, clearance " << common.region.clearance
       << " m, min observations " << common.region.min_observations << ", band " << common.region.band_low << " to "
-      << common.region.band_high << " m (free space, visibility); minimum group size " << common.min_group_size
+      << common.region.band_high << " m, door width " << common.region.door_width << " m, door depth "
+      << common.region.door_depth << " m (free space, visibility); minimum group size " << common.min_group_size
       << "; everything else the library's default.\n\n";
 
   out << "### Summary over the " << datasets.size() << " datasets\n\n"
@@ -646,7 +649,7 @@ const char* kUsage =
     "parameters (defaults: the library's):\n"
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
-    "  --band-low M  --band-high M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
+    "  --band-low M  --band-high M  --door-width M  --door-depth M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
     "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
     "selection (defaults: all):\n"
@@ -692,6 +695,8 @@ int main(int argc, char** argv) {
         {"--min-observations", integer(region.min_observations)},
         {"--band-low", number(region.band_low)},
         {"--band-high", number(region.band_high)},
+        {"--door-width", number(region.door_width)},
+        {"--door-depth", number(region.door_depth)},
         {"--min-group-size", integer(configuration.min_group_size)},
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--boundary-passes", integer(configuration.boundary_passes)},

@@ -22,7 +22,7 @@ void require(bool ok, const std::string& message) {
 /// The region settings the free-space model does not use.
 bool visibilityOnlyChanged(const RegionParameters& r, const RegionParameters& d) {
   return r.clearance != d.clearance || r.min_observations != d.min_observations || r.band_low != d.band_low ||
-         r.band_high != d.band_high;
+         r.band_high != d.band_high || r.door_width != d.door_width || r.door_depth != d.door_depth;
 }
 
 /// The first region setting that differs from its default, by name.
@@ -31,6 +31,8 @@ std::string firstChangedRegionSetting(const RegionParameters& r, const RegionPar
   if (r.max_range != d.max_range) return "regions.max_range";
   if (r.clearance != d.clearance) return "regions.clearance";
   if (r.min_observations != d.min_observations) return "regions.min_observations";
+  if (r.door_width != d.door_width) return "regions.door_width";
+  if (r.door_depth != d.door_depth) return "regions.door_depth";
   return "regions.band_low/band_high";
 }
 

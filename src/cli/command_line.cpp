@@ -214,6 +214,16 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->check(wholeNumber(1))
       ->capture_default_str()
       ->group("Sensed-space model");
+  command.add_option("--door-width", args.method.regions.door_width,
+                     "visibility: a view stops past an opening narrower than this (a door), metres; 0: never")
+      ->check(finiteNumber(0.0))
+      ->capture_default_str()
+      ->group("Sensed-space model");
+  command.add_option("--door-depth", args.method.regions.door_depth,
+                     "visibility: a narrow stretch longer than this is a passage, not a door, metres")
+      ->check(finiteNumber(0.0))
+      ->capture_default_str()
+      ->group("Sensed-space model");
   command.add_option("--band", args.band, "visibility, 3D: heights above the sensor that make the occupancy grid, "
                                           "LOW HIGH metres (default: " + std::to_string(args.method.regions.band_low) + " " +
                                           std::to_string(args.method.regions.band_high) + ")")
@@ -474,12 +484,13 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
   }
   // Options of one model given with another are a mistake, not a no-op.
   const bool points = args.method.model == SensedSpaceModel::Points;
-  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band"})
+  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band", "--door-width",
+                             "--door-depth"})
     if (points && partition.count(option))
       return std::string(option) + " applies to --sso free-space or visibility, not points";
   if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
   if (args.method.model == SensedSpaceModel::FreeSpace)
-    for (const char* option : {"--clearance", "--min-observations", "--band"})
+    for (const char* option : {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
   if (args.voxel) args.method.voxel_leaf = *args.voxel;
   if (!args.band.empty()) {

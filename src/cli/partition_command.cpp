@@ -291,6 +291,8 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
       p["clearance"] = method.regions.clearance;
       p["min_observations"] = method.regions.min_observations;
       p["band"] = {method.regions.band_low, method.regions.band_high};
+      p["door_width"] = method.regions.door_width;
+      p["door_depth"] = method.regions.door_depth;
     }
   }
   p["voxel"] = method.voxel_leaf;

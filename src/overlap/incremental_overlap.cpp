@@ -282,12 +282,12 @@ struct IncrementalOverlap::State {
   }
 
   void computeRegion(Slot& s, RegionMarker<2>& own, RegionMarker<2>& marker2, RegionMarker<3>& marker3,
-                     OccupancyGrid::Reader& reader) const {
+                     OccupancyGrid::Reader& reader, ViewWidths& widths) const {
     s.region.clear();
     if (!s.present) return;
     const PointSpan points{s.points.data(), s.points.data() + s.points.size()};
     if (model == SensedSpaceModel::Visibility)
-      visibilityOf(points, s.origin, params, grid, planar_used, reader, own, marker2, s.region);
+      visibilityOf(points, s.origin, params, grid, planar_used, reader, own, marker2, widths, s.region);
     else if (!planar_used)
       freeSpaceOf<3>(points, s.origin, params, grid, marker3, s.region);
     else
@@ -342,10 +342,11 @@ struct IncrementalOverlap::State {
       RegionMarker<2> own, marker2;
       RegionMarker<3> marker3;
       OccupancyGrid::Reader reader;
+      ViewWidths widths;
     };
     parallelForWithScratch(
-        affected.size(), threads, 2, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(occupancy)}; },
-        [&](std::size_t k, Scratch& s) { computeRegion(slots[affected[k]], s.own, s.marker2, s.marker3, s.reader); });
+        affected.size(), threads, 2, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(occupancy), {}}; },
+        [&](std::size_t k, Scratch& s) { computeRegion(slots[affected[k]], s.own, s.marker2, s.marker3, s.reader, s.widths); });
     SharedDelta shared;
     for (std::size_t k = 0; k < affected.size(); ++k) {
       const int i = affected[k];

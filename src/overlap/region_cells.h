@@ -307,12 +307,143 @@ inline bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, cons
   return height >= params.band_low && height <= params.band_high;
 }
 
+/// How wide the free space is around each cell of one view's box, across
+/// four axes (along x, along y and the two diagonals): the length of the run
+/// of free cells through the cell, between two blocked cells. A run that
+/// reaches the box's edge is open (wide). The visibility model's doors
+/// (RegionParameters::door_width) are the short stretches of a ray where the
+/// width across it is below a door's.
+class OpeningWidths {
+ public:
+  static constexpr int kAxes = 4;
+  static constexpr std::uint16_t kOpen = 0xffff;
+
+  /// Fills the table for the box [lo, hi]; blocked(cell) says whether a cell stops the view.
+  template <typename Blocked>
+  void compute(const Cell<2>& lo, const Cell<2>& hi, Blocked&& blocked) {
+    lo_ = lo;
+    nx_ = int(hi[0] - lo[0] + 1), ny_ = int(hi[1] - lo[1] + 1);
+    const std::size_t cells = std::size_t(nx_) * std::size_t(ny_);
+    blocked_.resize(cells);
+    for (int x = 0; x < nx_; ++x)
+      for (int y = 0; y < ny_; ++y) blocked_[index(x, y)] = blocked(Cell<2>{lo[0] + x, lo[1] + y});
+    // Free cells from the run's start (forward) and to its end (backward),
+    // kOpen when the run reaches the box's edge on that side.
+    forward_.assign(cells * kAxes, 0);
+    backward_.assign(cells * kAxes, 0);
+    for (int x = 0; x < nx_; ++x)
+      for (int y = 0; y < ny_; ++y) sweep(forward_, x, y, -1);
+    for (int x = nx_ - 1; x >= 0; --x)
+      for (int y = ny_ - 1; y >= 0; --y) sweep(backward_, x, y, +1);
+  }
+
+  /// The free run through cell c along axis k, in cells (c included), or
+  /// kOpen when it is not closed at both ends.
+  std::uint32_t run(const Cell<2>& c, int k) const {
+    const int x = int(c[0] - lo_[0]), y = int(c[1] - lo_[1]);
+    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return kOpen;
+    const std::size_t i = index(x, y) * kAxes + std::size_t(k);
+    if (forward_[i] == kOpen || backward_[i] == kOpen) return kOpen;
+    return std::uint32_t(forward_[i]) + backward_[i] - 1;
+  }
+
+  /// The step of axis k, in cells, and its length.
+  static std::array<int, 2> axis(int k) {
+    static constexpr int steps[kAxes][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+    return {steps[k][0], steps[k][1]};
+  }
+
+ private:
+  std::size_t index(int x, int y) const { return std::size_t(x) * std::size_t(ny_) + std::size_t(y); }
+  // One cell of a pass; `sign` -1 looks back along each axis, +1 ahead, at a
+  // neighbour the pass has already visited.
+  void sweep(std::vector<std::uint16_t>& runs, int x, int y, int sign) {
+    const std::size_t i = index(x, y);
+    if (blocked_[i]) return;  // 0: not free
+    for (int k = 0; k < kAxes; ++k) {
+      const auto a = axis(k);
+      const int px = x + sign * a[0], py = y + sign * a[1];
+      std::uint16_t& r = runs[i * kAxes + std::size_t(k)];
+      if (px < 0 || py < 0 || px >= nx_ || py >= ny_) {
+        r = kOpen;
+        continue;
+      }
+      const std::uint16_t before = runs[index(px, py) * kAxes + std::size_t(k)];
+      r = before == kOpen ? kOpen : std::uint16_t(std::min<int>(before + 1, kOpen - 1));
+    }
+  }
+
+  Cell<2> lo_{};
+  int nx_ = 0, ny_ = 0;
+  std::vector<char> blocked_;
+  std::vector<std::uint16_t> forward_, backward_;
+};
+
+/// The opening widths of one view: by its own surfaces (for the rays it saw
+/// along, as its own surfaces alone stop them) and by its own and the shared
+/// occupied cells (for the others).
+struct ViewWidths {
+  OpeningWidths own, shared;
+};
+
+/// Follows one ray of the visibility model through free cells and says when
+/// it has come through a door: a stretch no longer than door_depth where the
+/// free space across the ray is narrower than door_width, entered from and
+/// left into wider space. A ray that starts in a narrow spot (a pose in a
+/// doorway) sees both sides; a long narrow stretch is a passage, not a door.
+class DoorCrossing {
+ public:
+  DoorCrossing(const RegionParameters& params, double cell_size, double angle)
+      : width_(params.door_width / cell_size), depth_(params.door_depth / cell_size) {
+    const double dx = std::cos(angle), dy = std::sin(angle);
+    for (int k = 0; k < OpeningWidths::kAxes; ++k) {
+      const auto a = OpeningWidths::axis(k);
+      const double length = std::hypot(double(a[0]), double(a[1]));
+      // Across the ray: the axes at least 45 degrees from its direction.
+      if (std::abs(a[0] * dx + a[1] * dy) / length <= std::sqrt(0.5) + 1e-9) across_[count_++] = {k, length};
+    }
+  }
+  bool enabled() const { return width_ > 0; }
+
+  /// Called with each free cell the ray enters, in order; true once the ray
+  /// has come through a door into wide space (that cell is its last).
+  bool throughDoor(const Cell<2>& c, const OpeningWidths& widths) {
+    if (!narrowAt(c, widths)) {
+      const bool through = state_ == State::kInDoor;
+      state_ = State::kWide;
+      return through;
+    }
+    if (state_ == State::kWide) state_ = State::kInDoor, narrow_cells_ = 0;
+    if (state_ == State::kInDoor && ++narrow_cells_ > depth_) state_ = State::kNarrow;
+    return false;
+  }
+
+ private:
+  bool narrowAt(const Cell<2>& c, const OpeningWidths& widths) const {
+    for (int j = 0; j < count_; ++j) {
+      const std::uint32_t run = widths.run(c, across_[j].axis);
+      if (run != OpeningWidths::kOpen && run * across_[j].length < width_) return true;
+    }
+    return false;
+  }
+  enum class State { kNarrow, kWide, kInDoor };
+  struct Across {
+    int axis;
+    double length;
+  };
+  double width_, depth_;
+  std::array<Across, OpeningWidths::kAxes> across_{};
+  int count_ = 0;
+  State state_ = State::kNarrow;
+  int narrow_cells_ = 0;
+};
+
 /// The cells visible from observation i's position: rays all around it at a
 /// fixed set of world angles (so the heading plays no part), each stopped by
 /// the first occupied cell it enters beyond the clearance, that cell included.
 inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
                          const CellGrid& grid, bool planar, OccupancyGrid::Reader& occupancy, RegionMarker<2>& own,
-                         RegionMarker<2>& marker, std::vector<std::uint64_t>& out) {
+                         RegionMarker<2>& marker, ViewWidths& widths, std::vector<std::uint64_t>& out) {
   if (points.empty()) return;  // an observation with no point sensed nothing
   const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
   const auto o = grid.inCells<2>(origin);
@@ -334,6 +465,11 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
       if (angle < 0) angle += kTwoPi;
       covered[std::min(rays - 1, int(std::lround(angle / kTwoPi * rays)) % rays)] = 1;
     }
+  const bool doors = params.door_width > 0;
+  if (doors) {
+    widths.shared.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c) || occupancy.occupied(c); });
+    widths.own.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c); });
+  }
   marker.reset(lo, hi);
   for (int r = 0; r < rays; ++r) {
     const double angle = kTwoPi * r / rays;
@@ -346,10 +482,16 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // Only the occupied cells a ray starts among are passed, and only
     // within the clearance: once it has crossed a free cell, the next
     // occupied cell is a wall seen from inside and stops it.
+    // A ray that comes through a door stops in the first wide cell beyond
+    // it: the view is of the place the observation stands in.
     bool crossed_free = false;
+    DoorCrossing door(params, grid.size, angle);
     traverse<2>(o, end, [&](const Cell<2>& c, double t) {
       marker.mark(c);
-      if (!own.marked(c) && (own_view || !occupancy.occupied(c))) return crossed_free = true;
+      if (!own.marked(c) && (own_view || !occupancy.occupied(c))) {
+        crossed_free = true;
+        return !doors || !door.throughDoor(c, own_view ? widths.own : widths.shared);
+      }
       return !crossed_free && t < clear;
     });
   }

@@ -198,14 +198,15 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
     RegionMarker<2> marker2, own_surfaces;
     RegionMarker<3> marker3;
     OccupancyGrid::Reader reader;
+    ViewWidths widths;
   };
   parallelForWithScratch(
-      n, threads, 8, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(grid)}; },
+      n, threads, 8, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(grid), {}}; },
       [&](std::size_t i, Scratch& s) {
         if (interruptRequested(interrupt)) return;
         if (model == SensedSpaceModel::Visibility)
           visibilityOf(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, regions.planar, s.reader,
-                       s.own_surfaces, s.marker2, per_observation[i]);
+                       s.own_surfaces, s.marker2, s.widths, per_observation[i]);
         else if (volumetric)
           freeSpaceOf<3>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker3, per_observation[i]);
         else
@@ -364,6 +365,10 @@ void checkRegionParameters(const RegionParameters& p) {
     throw std::invalid_argument("region range is more than 2000 cells: raise the cell size or lower the range");
   if (!(std::isfinite(p.clearance) && p.clearance >= 0)) throw std::invalid_argument("clearance must be finite and >= 0");
   if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
+  if (!(std::isfinite(p.door_width) && p.door_width >= 0)) throw std::invalid_argument("door width must be finite and >= 0");
+  if (!(std::isfinite(p.door_depth) && p.door_depth >= 0)) throw std::invalid_argument("door depth must be finite and >= 0");
+  // An opening's width is counted in cells of up to 16 bits.
+  if (p.door_width / p.cell_size > 60000) throw std::invalid_argument("door width is more than 60000 cells");
   if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
     throw std::invalid_argument("height band must be finite with low < high");
 }

@@ -207,6 +207,35 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCell
   return owner;
 }
 
+/// The free cell an observation stands in goes to its own group (to the
+/// group of most observations standing in it; ties: the lower group): the
+/// place a scan was taken in holds its pose, even where the floor around a
+/// doorway or a corridor's cut is held by more of the next group's views.
+void keepPoseCells(const GridFrame& f, const std::vector<Occupancy>& occupancy,
+                   const std::vector<std::vector<int>>& groups, const std::vector<Eigen::Vector3d>& sensor_origins,
+                   std::vector<int>& label) {
+  std::vector<std::pair<std::size_t, int>> standing;  // (cell, group)
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int i : groups[g])
+      if (const auto k = f.indexOf(sensor_origins[std::size_t(i)].x(), sensor_origins[std::size_t(i)].y());
+          k && occupancy[*k] == Occupancy::Free)
+        standing.emplace_back(*k, int(g));
+  std::sort(standing.begin(), standing.end());
+  for (std::size_t a = 0; a < standing.size();) {
+    std::size_t best_count = 0;
+    int best = kNone;
+    std::size_t b = a;
+    while (b < standing.size() && standing[b].first == standing[a].first) {
+      std::size_t e = b;
+      while (e < standing.size() && standing[e] == standing[b]) ++e;
+      if (e - b > best_count) best_count = e - b, best = standing[b].second;
+      b = e;
+    }
+    label[standing[a].first] = best;
+    a = b;
+  }
+}
+
 /// Keeps a cell only when some 2x2 block of its label holds it (a morphological
 /// opening by a 2x2 square): one-cell-wide spokes and lines go.
 std::vector<int> openedLabels(const FloorGrid& g, const std::vector<int>& label) {
@@ -621,6 +650,7 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, cell_of, groups, map.occupancy)) : std::vector<int>{};
   const double cell_area = g.resolution * g.resolution;
   dropSpecks(label, piecesOf(g, label), std::size_t(std::ceil(options.min_piece_area / cell_area)));
+  if (cells) keepPoseCells(f, map.occupancy, groups, sensor_origins, label);
   const Pieces pieces = piecesOf(g, label);
 
   map.places.resize(groups.size());

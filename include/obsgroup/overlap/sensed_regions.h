@@ -77,6 +77,14 @@ struct RegionParameters {
   /// over the floor: 0.3 to 1.8 m above the floor), metres.
   double band_low = -0.7;
   double band_high = 0.8;
+  /// Visibility: a ray stops once it has come through a door, an opening
+  /// narrower than this between wider free space, so that an observation's
+  /// region is the place it stands in and not the rooms it looks into,
+  /// metres; 0: doors do not stop the view.
+  double door_width = 1.2;
+  /// Visibility: a narrow stretch longer than this along the ray is a
+  /// passage (a narrow corridor), not a door, and does not stop it, metres.
+  double door_depth = 1.0;
 };
 
 /// Throws std::invalid_argument naming the first parameter out of range.
@@ -89,7 +97,8 @@ bool isPlanarData(const WorldPoints& world, const std::vector<Eigen::Vector3d>& 
 
 inline bool operator==(const RegionParameters& a, const RegionParameters& b) {
   return a.cell_size == b.cell_size && a.max_range == b.max_range && a.clearance == b.clearance &&
-         a.min_observations == b.min_observations && a.band_low == b.band_low && a.band_high == b.band_high;
+         a.min_observations == b.min_observations && a.band_low == b.band_low && a.band_high == b.band_high &&
+         a.door_width == b.door_width && a.door_depth == b.door_depth;
 }
 inline bool operator!=(const RegionParameters& a, const RegionParameters& b) { return !(a == b); }
 
