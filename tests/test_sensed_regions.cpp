@@ -363,6 +363,37 @@ TEST(SensedRegions, ADoorStopsTheViewAndAWideOpeningDoesNot) {
   }
 }
 
+TEST(SensedRegions, APoseInADoorwaySeesTheSideItStandsOn) {
+  // Two rooms through a 1 m door in a 0.6 m thick wall (x 5.7 to 6.3).
+  sim::FloorPlan plan;
+  plan.addWallX(0.0, -0.1, 12.1);
+  plan.addWallX(5.0, -0.1, 12.1);
+  plan.addWallY(0.0, 0.0, 5.0);
+  plan.addWallY(12.0, 0.0, 5.0);
+  plan.addWallY(6.0, 0.0, 5.0, {{2.0, 3.0}}, 0.6);
+  RegionParameters doors = sceneParameters();
+  doors.door_width = RegionParameters{}.door_width;
+  const auto scene = [&](double x) {
+    const std::vector<Obs> obs{scanAt(plan, kWestMiddle, allAround()), scanAt(plan, kEastMiddle, allAround()),
+                               scanAt(plan, {x, 2.55, 0.0}, allAround())};
+    return overlap(obs, SensedSpaceModel::Visibility, doors);
+  };
+  // In the doorway, 0.1 m from the west room and 0.5 m from the east one:
+  // it sees the west room, and of the east one only the first cells past
+  // the door.
+  const OverlapResult west_side = scene(5.8);
+  EXPECT_GT(pi(west_side, 0, 2), 0.8);
+  EXPECT_LT(pi(west_side, 1, 2), 0.05);
+  // Mirrored: the east room.
+  const OverlapResult east_side = scene(6.2);
+  EXPECT_GT(pi(east_side, 1, 2), 0.8);
+  EXPECT_LT(pi(east_side, 0, 2), 0.05);
+  // In the middle of the doorway it sees both rooms.
+  const OverlapResult middle = scene(6.0);
+  EXPECT_GT(pi(middle, 0, 2), 0.5);
+  EXPECT_GT(pi(middle, 1, 2), 0.5);
+}
+
 // --- 4. 3D --------------------------------------------------------------------
 
 TEST(SensedRegions, VisibilityOnDepthCloudsMatchesTwoDimensionalScans) {

@@ -379,11 +379,12 @@ class OpeningWidths {
   std::vector<std::uint16_t> forward_, backward_;
 };
 
-/// The opening widths of one view: by its own surfaces (for the rays it saw
+/// The opening widths of one view, and scratch for its rays: by its own surfaces (for the rays it saw
 /// along, as its own surfaces alone stop them) and by its own and the shared
 /// occupied cells (for the others).
 struct ViewWidths {
   OpeningWidths own, shared;
+  std::vector<int> to_wide;  ///< per ray: narrow cells before its first wide one (-1: none)
 };
 
 /// Follows one ray of the visibility model through free cells and says when
@@ -404,6 +405,17 @@ class DoorCrossing {
     }
   }
   bool enabled() const { return width_ > 0; }
+  /// The ray starts in a doorway and leaves it on the far side from the
+  /// pose: the first wide cell is beyond the door.
+  void startInDoorway() { state_ = State::kInDoor, narrow_cells_ = 0; }
+  /// Whether the free space across the ray is narrower than a door at c.
+  bool narrowAt(const Cell<2>& c, const OpeningWidths& widths) const {
+    for (int j = 0; j < count_; ++j) {
+      const std::uint32_t run = widths.run(c, across_[j].axis);
+      if (run != OpeningWidths::kOpen && run * across_[j].length < width_) return true;
+    }
+    return false;
+  }
 
   /// Called with each free cell the ray enters, in order; true once the ray
   /// has come through a door into wide space (that cell is its last).
@@ -419,13 +431,6 @@ class DoorCrossing {
   }
 
  private:
-  bool narrowAt(const Cell<2>& c, const OpeningWidths& widths) const {
-    for (int j = 0; j < count_; ++j) {
-      const std::uint32_t run = widths.run(c, across_[j].axis);
-      if (run != OpeningWidths::kOpen && run * across_[j].length < width_) return true;
-    }
-    return false;
-  }
   enum class State { kNarrow, kWide, kInDoor };
   struct Across {
     int axis;
@@ -470,8 +475,9 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     widths.shared.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c) || occupancy.occupied(c); });
     widths.own.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c); });
   }
-  marker.reset(lo, hi);
-  for (int r = 0; r < rays; ++r) {
+  // Walks ray r through the cells it sees, calling free_cell(cell) on each
+  // free one (false stops it) and seen(cell) on every cell.
+  const auto walk = [&](int r, auto&& free_cell, auto&& seen) {
     const double angle = kTwoPi * r / rays;
     const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
     // Where the observation looked, its own beams say what it saw: only its
@@ -482,18 +488,53 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // Only the occupied cells a ray starts among are passed, and only
     // within the clearance: once it has crossed a free cell, the next
     // occupied cell is a wall seen from inside and stops it.
-    // A ray that comes through a door stops in the first wide cell beyond
-    // it: the view is of the place the observation stands in.
     bool crossed_free = false;
-    DoorCrossing door(params, grid.size, angle);
     traverse<2>(o, end, [&](const Cell<2>& c, double t) {
-      marker.mark(c);
+      seen(c);
       if (!own.marked(c) && (own_view || !occupancy.occupied(c))) {
         crossed_free = true;
-        return !doors || !door.throughDoor(c, own_view ? widths.own : widths.shared);
+        return free_cell(c, own_view ? widths.own : widths.shared);
       }
       return !crossed_free && t < clear;
     });
+  };
+  const auto angleOf = [&](int r) { return kTwoPi * r / rays; };
+  // A pose in a doorway (its rays start narrow) stands on the side whose
+  // wide space is nearer: each ray's narrow cells before its first wide one,
+  // -1 when it never reaches wide space.
+  std::vector<int>& to_wide = widths.to_wide;
+  if (doors) {
+    to_wide.assign(rays, -1);
+    for (int r = 0; r < rays; ++r) {
+      const DoorCrossing probe(params, grid.size, angleOf(r));
+      int narrow = 0;
+      walk(
+          r,
+          [&](const Cell<2>& c, const OpeningWidths& w) {
+            if (probe.narrowAt(c, w)) {
+              ++narrow;
+              return true;
+            }
+            to_wide[r] = narrow;
+            return false;
+          },
+          [](const Cell<2>&) {});
+    }
+  }
+  marker.reset(lo, hi);
+  for (int r = 0; r < rays; ++r) {
+    // A ray that comes through a door stops in the first wide cell beyond
+    // it: the view is of the place the observation stands in. From a
+    // doorway, the far side is beyond the door.
+    DoorCrossing door(params, grid.size, angleOf(r));
+    if (doors) {
+      const int opposite = to_wide[(r + rays / 2) % rays];
+      // More than one cell nearer: a pose in the middle of the doorway sees both sides.
+      if (to_wide[r] > 0 && opposite >= 0 && opposite + 1 < to_wide[r]) door.startInDoorway();
+    }
+    walk(
+        r, [&](const Cell<2>& c, const OpeningWidths& w) { return !doors || !door.throughDoor(c, w); },
+        [&](const Cell<2>& c) { marker.mark(c); });
   }
   marker.emit(out);
 }
