@@ -620,6 +620,7 @@ TEST(SensedRegions, BadParametersAreRejected) {
   add("clearance < 0", [](RegionParameters& p) { p.clearance = -0.1; });
   add("door_width < 0", [](RegionParameters& p) { p.door_width = -0.1; });
   add("door_depth NaN", [](RegionParameters& p) { p.door_depth = std::numeric_limits<double>::quiet_NaN(); });
+  add("door width of 250 cells", [](RegionParameters& p) { p.cell_size = 0.01, p.door_width = 2.5; });
   add("min_observations 0", [](RegionParameters& p) { p.min_observations = 0; });
   add("band low == high", [](RegionParameters& p) { p.band_low = p.band_high = 0.5; });
   add("band low > high", [](RegionParameters& p) { p.band_low = 1.0, p.band_high = -1.0; });

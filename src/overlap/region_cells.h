@@ -316,7 +316,9 @@ inline bool inBand(const Eigen::Vector3f& p, const Eigen::Vector3d& origin, cons
 class OpeningWidths {
  public:
   static constexpr int kAxes = 4;
-  static constexpr std::uint16_t kOpen = 0xffff;
+  /// A run that is not closed at both ends, or longer than any door
+  /// (checkRegionParameters keeps door_width under 250 cells).
+  static constexpr std::uint8_t kOpen = 0xff;
 
   /// Fills the table for the box [lo, hi]; blocked(cell) says whether a cell stops the view.
   template <typename Blocked>
@@ -347,7 +349,7 @@ class OpeningWidths {
     return std::uint32_t(forward_[i]) + backward_[i] - 1;
   }
 
-  /// The step of axis k, in cells, and its length.
+  /// The step of axis k, in cells.
   static std::array<int, 2> axis(int k) {
     static constexpr int steps[kAxes][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
     return {steps[k][0], steps[k][1]};
@@ -357,31 +359,32 @@ class OpeningWidths {
   std::size_t index(int x, int y) const { return std::size_t(x) * std::size_t(ny_) + std::size_t(y); }
   // One cell of a pass; `sign` -1 looks back along each axis, +1 ahead, at a
   // neighbour the pass has already visited.
-  void sweep(std::vector<std::uint16_t>& runs, int x, int y, int sign) {
+  void sweep(std::vector<std::uint8_t>& runs, int x, int y, int sign) {
     const std::size_t i = index(x, y);
     if (blocked_[i]) return;  // 0: not free
     for (int k = 0; k < kAxes; ++k) {
       const auto a = axis(k);
       const int px = x + sign * a[0], py = y + sign * a[1];
-      std::uint16_t& r = runs[i * kAxes + std::size_t(k)];
+      std::uint8_t& r = runs[i * kAxes + std::size_t(k)];
       if (px < 0 || py < 0 || px >= nx_ || py >= ny_) {
         r = kOpen;
         continue;
       }
-      const std::uint16_t before = runs[index(px, py) * kAxes + std::size_t(k)];
-      r = before == kOpen ? kOpen : std::uint16_t(std::min<int>(before + 1, kOpen - 1));
+      // Runs longer than kOpen - 1 cells are wider than any door: open.
+      const std::uint8_t before = runs[index(px, py) * kAxes + std::size_t(k)];
+      r = before >= kOpen - 1 ? kOpen : std::uint8_t(before + 1);
     }
   }
 
   Cell<2> lo_{};
   int nx_ = 0, ny_ = 0;
   std::vector<char> blocked_;
-  std::vector<std::uint16_t> forward_, backward_;
+  std::vector<std::uint8_t> forward_, backward_;
 };
 
-/// The opening widths of one view, and scratch for its rays: by its own surfaces (for the rays it saw
-/// along, as its own surfaces alone stop them) and by its own and the shared
-/// occupied cells (for the others).
+/// The opening widths of one view, and scratch for its rays: by its own
+/// surfaces (for the rays it saw along, as its own surfaces alone stop them)
+/// and by its own and the shared occupied cells (for the others).
 struct ViewWidths {
   OpeningWidths own, shared;
   std::vector<int> to_wide;  ///< per ray: narrow cells before its first wide one (-1: none)
@@ -390,8 +393,10 @@ struct ViewWidths {
 /// Follows one ray of the visibility model through free cells and says when
 /// it has come through a door: a stretch no longer than door_depth where the
 /// free space across the ray is narrower than door_width, entered from and
-/// left into wider space. A ray that starts in a narrow spot (a pose in a
-/// doorway) sees both sides; a long narrow stretch is a passage, not a door.
+/// left into wider space. A long narrow stretch is a passage, not a door. A
+/// ray that starts in a narrow spot (a pose in a doorway) goes on into the
+/// wide space it meets, unless told that this is the far side
+/// (startInDoorway).
 class DoorCrossing {
  public:
   DoorCrossing(const RegionParameters& params, double cell_size, double angle)
@@ -404,7 +409,6 @@ class DoorCrossing {
       if (std::abs(a[0] * dx + a[1] * dy) / length <= std::sqrt(0.5) + 1e-9) across_[count_++] = {k, length};
     }
   }
-  bool enabled() const { return width_ > 0; }
   /// The ray starts in a doorway and leaves it on the far side from the
   /// pose: the first wide cell is beyond the door.
   void startInDoorway() { state_ = State::kInDoor, narrow_cells_ = 0; }

@@ -367,8 +367,9 @@ void checkRegionParameters(const RegionParameters& p) {
   if (p.min_observations < 1) throw std::invalid_argument("min_observations must be >= 1");
   if (!(std::isfinite(p.door_width) && p.door_width >= 0)) throw std::invalid_argument("door width must be finite and >= 0");
   if (!(std::isfinite(p.door_depth) && p.door_depth >= 0)) throw std::invalid_argument("door depth must be finite and >= 0");
-  // An opening's width is counted in cells of up to 16 bits.
-  if (p.door_width / p.cell_size > 60000) throw std::invalid_argument("door width is more than 60000 cells");
+  // An opening's width is counted in cells in a byte.
+  if (p.door_width / p.cell_size >= 250)
+    throw std::invalid_argument("door width is 250 cells or more: raise the cell size or lower the door width");
   if (!(std::isfinite(p.band_low) && std::isfinite(p.band_high) && p.band_low < p.band_high))
     throw std::invalid_argument("height band must be finite with low < high");
 }
