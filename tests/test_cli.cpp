@@ -664,6 +664,14 @@ TEST_F(Cli, UsageErrors) {
   EXPECT_NE(delta.err.find("--delta applies to --sso points"), std::string::npos) << delta.err;
   EXPECT_EQ(run("partition " + input + out + " --sso points --cell 0.3").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --sso free-space --clearance 0.5").code, 2);
+  for (const char* model : {"points", "free-space"}) {
+    const Result door = run("partition " + input + out + " --sso " + model + " --door-width 1");
+    EXPECT_EQ(door.code, 2) << model;
+    EXPECT_NE(door.err.find("--door-width applies to --sso visibility only"), std::string::npos) << door.err;
+  }
+  EXPECT_EQ(run("partition " + input + out + " --door-width -1").code, 2);
+  // A door of 250 cells or more is refused with the region settings (GroupingParameters::check).
+  EXPECT_EQ(run("partition " + input + out + " --cell 0.01 --door-width 3").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --paper --split best").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --paper --ncut-threshold 0.8").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --band 1 0").code, 2);

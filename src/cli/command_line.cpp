@@ -484,12 +484,11 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
   }
   // Options of one model given with another are a mistake, not a no-op.
   const bool points = args.method.model == SensedSpaceModel::Points;
-  for (const char* option : {"--cell", "--range", "--clearance", "--min-observations", "--band", "--door-width",
-                             "--door-depth"})
+  for (const char* option : {"--cell", "--range"})
     if (points && partition.count(option))
       return std::string(option) + " applies to --sso free-space or visibility, not points";
   if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
-  if (args.method.model == SensedSpaceModel::FreeSpace)
+  if (args.method.model != SensedSpaceModel::Visibility)
     for (const char* option : {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
   if (args.voxel) args.method.voxel_leaf = *args.voxel;
