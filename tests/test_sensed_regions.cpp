@@ -57,18 +57,23 @@ sim::FloorPlan oneRoom() {
   return plan;
 }
 
-/// Two 6 x 5 m rooms side by side, the wall between them at x = 6 with a
-/// 1 m door (y 2 to 3) or none.
-sim::FloorPlan twoRooms(bool door) {
+/// Two 6 x 5 m rooms side by side, the wall between them at x = 6 (`thickness`
+/// thick) with an opening `opening` wide centred on y = 2.5, or none.
+sim::FloorPlan twoRoomsThrough(double opening, double thickness = 0.2) {
   sim::FloorPlan plan;
   plan.addWallX(0.0, -0.1, 12.1);
   plan.addWallX(5.0, -0.1, 12.1);
   plan.addWallY(0.0, 0.0, 5.0);
   plan.addWallY(12.0, 0.0, 5.0);
-  plan.addWallY(6.0, 0.0, 5.0, door ? std::vector<std::pair<double, double>>{{2.0, 3.0}}
-                                    : std::vector<std::pair<double, double>>{});
+  plan.addWallY(6.0, 0.0, 5.0,
+                opening > 0 ? std::vector<std::pair<double, double>>{{2.5 - opening / 2, 2.5 + opening / 2}}
+                            : std::vector<std::pair<double, double>>{},
+                thickness);
   return plan;
 }
+
+/// twoRoomsThrough with a 1 m door (y 2 to 3) or none.
+sim::FloorPlan twoRooms(bool door) { return twoRoomsThrough(door ? 1.0 : 0.0); }
 
 /// The middles of the two rooms of twoRooms() (the first is the grid's
 /// anchor), and a second place in the west room.
@@ -329,20 +334,11 @@ TEST(SensedRegions, ClearanceLetsAPoseInAWallCellSee) {
 TEST(SensedRegions, ADoorStopsTheViewAndAWideOpeningDoesNot) {
   // Two rooms through a 1 m door, and the same rooms through a 2.5 m opening:
   // from the middle of each room, 360-degree scans.
-  const auto opening = [](double width) {
-    sim::FloorPlan plan;
-    plan.addWallX(0.0, -0.1, 12.1);
-    plan.addWallX(5.0, -0.1, 12.1);
-    plan.addWallY(0.0, 0.0, 5.0);
-    plan.addWallY(12.0, 0.0, 5.0);
-    plan.addWallY(6.0, 0.0, 5.0, {{2.5 - width / 2, 2.5 + width / 2}});
-    return plan;
-  };
   RegionParameters doors = sceneParameters(), no_doors = sceneParameters();
   doors.door_width = RegionParameters{}.door_width;
   ASSERT_EQ(doors.door_width, 1.2);
   {
-    const auto plan = opening(1.0);
+    const auto plan = twoRooms(true);
     const std::vector<Obs> obs{scanAt(plan, kWestMiddle, allAround()), scanAt(plan, kEastMiddle, allAround())};
     const OverlapResult through = overlap(obs, SensedSpaceModel::Visibility, no_doors);
     const OverlapResult stopped = overlap(obs, SensedSpaceModel::Visibility, doors);
@@ -356,7 +352,7 @@ TEST(SensedRegions, ADoorStopsTheViewAndAWideOpeningDoesNot) {
   }
   {
     // 2.5 m is no door: the view runs on as without doors.
-    const auto plan = opening(2.5);
+    const auto plan = twoRoomsThrough(2.5);
     const std::vector<Obs> obs{scanAt(plan, kWestMiddle, allAround()), scanAt(plan, kEastMiddle, allAround())};
     expectSameMatrix(overlap(obs, SensedSpaceModel::Visibility, no_doors),
                      overlap(obs, SensedSpaceModel::Visibility, doors));
@@ -365,12 +361,7 @@ TEST(SensedRegions, ADoorStopsTheViewAndAWideOpeningDoesNot) {
 
 TEST(SensedRegions, APoseInADoorwaySeesTheSideItStandsOn) {
   // Two rooms through a 1 m door in a 0.6 m thick wall (x 5.7 to 6.3).
-  sim::FloorPlan plan;
-  plan.addWallX(0.0, -0.1, 12.1);
-  plan.addWallX(5.0, -0.1, 12.1);
-  plan.addWallY(0.0, 0.0, 5.0);
-  plan.addWallY(12.0, 0.0, 5.0);
-  plan.addWallY(6.0, 0.0, 5.0, {{2.0, 3.0}}, 0.6);
+  const auto plan = twoRoomsThrough(1.0, 0.6);
   RegionParameters doors = sceneParameters();
   doors.door_width = RegionParameters{}.door_width;
   const auto scene = [&](double x) {
