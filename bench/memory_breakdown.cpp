@@ -53,11 +53,10 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
                                                      capacityBytes(world.boxes),
                   "overlap, places, pictures"});
   const obsgroup::ObservationRegions& regions = grouping.getRegions();
-  rows.push_back({"region cells (8 B a cell of a region)", capacityBytes(regions.cells) + capacityBytes(regions.offsets),
-                  "overlap, places"});
+  rows.push_back({"regions (10 B a run of cells)", double(regions.bytes()), "overlap, places"});
   // countSharedCells' index: a watcher per region cell (its start per distinct cell and its tile
   // slots, a few per cent more, are left out).
-  rows.push_back({"shared-cell index (4 B a cell of a region)", 4.0 * double(regions.cells.size()), "overlap"});
+  rows.push_back({"shared-cell index (4 B a cell of a region)", 4.0 * double(regions.totalCells()), "overlap"});
   const obsgroup::OverlapResult& overlap = grouping.getOverlap();
   rows.push_back({"Pi and the pairs of Psi", double(overlap.match_ratio.nonZeros()) * (sizeof(double) + sizeof(int)) +
                                                  capacityBytes(overlap.pairs),
@@ -66,9 +65,10 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
   double partition_bytes = capacityBytes(partition.group_of);
   for (const auto& g : partition.groups) partition_bytes += capacityBytes(g);
   rows.push_back({"groups", partition_bytes, "from the partition on"});
-  std::printf("observations %zu, points %zu, region cells %zu (%.0f a region), edges %zu\n", observations.size(),
-              world.points.size(), regions.cells.size(), double(regions.cells.size()) / double(observations.size()),
-              overlap.pairs.size());
+  std::printf("observations %zu, points %zu, region cells %zu (%.0f a region) in %zu runs (%.0f a region), edges %zu\n",
+              observations.size(), world.points.size(), regions.totalCells(),
+              double(regions.totalCells()) / double(observations.size()), regions.runCount(),
+              double(regions.runCount()) / double(observations.size()), overlap.pairs.size());
   return rows;
 }
 

@@ -98,8 +98,8 @@ TEST(Places, TheRegionsTheGroupingKeepsAreThoseItWouldComputeAndGiveTheSameGroup
   EXPECT_EQ(plain.getRegions().size(), 0);  // not kept unless asked
   const ObservationRegions again =
       keeping.getSensedSpaceOverlap().computeRegions(observations, keeping.getSensedSpaceOverlap().toWorld(observations));
-  EXPECT_EQ(keeping.getRegions().cells, again.cells);
-  EXPECT_EQ(keeping.getRegions().offsets, again.offsets);
+  EXPECT_TRUE(keeping.getRegions() == again);
+  EXPECT_GT(again.totalCells(), 0u);
   // The points model has no regions.
   keeping.setParameters(GroupingParameters::paper());
   keeping.compute();
@@ -195,7 +195,7 @@ TEST(Places, BadArgumentsAreRefused) {
   WorldPoints one;
   one.appendAll({{Eigen::Vector3f(1, 2, 0), Eigen::Vector3f(-3, 0.5f, 0)}});
   ObservationRegions no_cells;
-  no_cells.offsets = {0, 0};
+  no_cells.append({});
   const PlaceMap bare = buildPlaceMap(no_cells, one, {Eigen::Vector3d::Zero()}, {{0}}, {5});
   ASSERT_EQ(bare.places.size(), 1u);
   EXPECT_EQ(bare.places[0].area_m2, 0.0);

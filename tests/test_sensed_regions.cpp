@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <set>
 #include <string>
@@ -457,18 +458,20 @@ TEST(SensedRegions, FreeSpaceIsVoxelsIn3DAndCellsIn2D) {
   // and the walls up to 1 + 2.95 * 0.41 = 2.2 m over the floor, 22 degrees
   // above the axis (z = 1.2: voxel 5; the 2.6 m ceiling lies out of view).
   std::int64_t lowest = std::numeric_limits<std::int64_t>::max(), highest = std::numeric_limits<std::int64_t>::min();
-  for (std::uint64_t key : voxels.cells) {
-    const std::int64_t iz = std::lround(voxels.cellCentre(key).z() / kCell);
-    lowest = std::min(lowest, iz);
-    highest = std::max(highest, iz);
-  }
+  for (int i = 0; i < voxels.size(); ++i)
+    voxels.forEachCell(i, [&](std::uint64_t key) {
+      const std::int64_t iz = std::lround(voxels.cellCentre(key).z() / kCell);
+      lowest = std::min(lowest, iz);
+      highest = std::max(highest, iz);
+    });
   EXPECT_GE(lowest, -5);
   EXPECT_LE(lowest, -4);
   EXPECT_EQ(highest, 5);
   for (int i = 0; i < voxels.size(); ++i) {
-    EXPECT_TRUE(std::is_sorted(voxels.cells.begin() + voxels.offsets[i], voxels.cells.begin() + voxels.offsets[i + 1]));
-    EXPECT_EQ(std::adjacent_find(voxels.cells.begin() + voxels.offsets[i], voxels.cells.begin() + voxels.offsets[i + 1]),
-              voxels.cells.begin() + voxels.offsets[i + 1]);
+    const std::vector<std::uint64_t> keys = voxels.cellsOf(i);
+    EXPECT_EQ(keys.size(), voxels.count(i));
+    EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+    EXPECT_EQ(std::adjacent_find(keys.begin(), keys.end()), keys.end());
   }
   // The same numbers reach OverlapResult through SensedSpaceOverlap.
   const OverlapResult r = overlap(depth, SensedSpaceModel::FreeSpace);
@@ -483,8 +486,8 @@ TEST(SensedRegions, FreeSpaceIsVoxelsIn3DAndCellsIn2D) {
   EXPECT_TRUE(cells.planar);
   for (int i = 0; i < 2; ++i) {
     int own = 0;
-    for (std::size_t k = cells.offsets[i]; k < cells.offsets[i + 1]; ++k) {
-      const Eigen::Vector3d c = cells.cellCentre(cells.cells[k]) + Eigen::Vector3d(3.05, 2.55, 0.0);
+    for (std::uint64_t key : cells.cellsOf(int(i))) {
+      const Eigen::Vector3d c = cells.cellCentre(key) + Eigen::Vector3d(3.05, 2.55, 0.0);
       own += c.head<2>().isApprox(Eigen::Vector2d(3.05, 2.55));
       EXPECT_TRUE(c.x() > 0.1 - kCell && c.x() < 5.9 + kCell && c.y() > 0.1 - kCell && c.y() < 4.9 + kCell)
           << c.transpose();
@@ -510,8 +513,8 @@ TEST(SensedRegions, ThreadCountChangesNothing) {
     }
     if (model == SensedSpaceModel::Points) continue;
     const ObservationRegions a = regionsOf(obs, model, {}, 1), b = regionsOf(obs, model, {}, 3);
-    EXPECT_EQ(a.cells, b.cells);
-    EXPECT_EQ(a.offsets, b.offsets);
+    EXPECT_TRUE(a == b);
+    EXPECT_GT(a.totalCells(), 0u);
   }
 }
 
@@ -652,9 +655,31 @@ TEST(SensedRegions, SharedCellsOfHandMadeRegions) {
   // R4 = {2^63}, alone.
   const std::uint64_t big = std::uint64_t(1) << 40, top = std::uint64_t(1) << 63;
   ObservationRegions regions;
-  regions.cells = {1, 2, 3, 4, big, 3, 4, 5, 5, big, top};
-  regions.offsets = {0, 5, 8, 10, 10, 11};
+  for (const std::vector<std::uint64_t>& cells : std::vector<std::vector<std::uint64_t>>{
+           {1, 2, 3, 4, big}, {3, 4, 5}, {5, big}, {}, {top}})
+    regions.append(cells);
   ASSERT_EQ(regions.size(), 5);
+  EXPECT_EQ(regions.totalCells(), 11u);
+  EXPECT_EQ(regions.runCount(), 6u);  // {1-4, 2^40}, {3-5}, {5}, {2^40}, {2^63}
+  EXPECT_EQ(regions.cellsOf(0), (std::vector<std::uint64_t>{1, 2, 3, 4, big}));
+  EXPECT_EQ(regions.firstKey(), 1u);
+  // Keys out of order or repeated are refused, naming the region.
+  ObservationRegions bad = regions;
+  EXPECT_THROW(bad.append({7, 6}), std::invalid_argument);
+  EXPECT_THROW(bad.append({7, 7}), std::invalid_argument);
+  const std::uint16_t lengths[] = {2, 1};
+  const std::uint64_t overlapping[] = {10, 11}, touching[] = {10, 12}, apart[] = {10, 13};
+  EXPECT_THROW(bad.appendRuns(overlapping, lengths, 2), std::invalid_argument);  // 10-11, then 11 again
+  EXPECT_THROW(bad.appendRuns(touching, lengths, 2), std::invalid_argument);     // 10-11, 12: one run
+  EXPECT_TRUE(bad == regions);  // nothing added by a refused region
+  bad.appendRuns(apart, lengths, 2);
+  EXPECT_EQ(bad.cellsOf(5), (std::vector<std::uint64_t>{10, 11, 13}));
+  // A run longer than a length holds is split, and the two halves read back whole.
+  std::vector<std::uint64_t> long_run(70000);
+  std::iota(long_run.begin(), long_run.end(), std::uint64_t(100));
+  bad.append(long_run);
+  EXPECT_EQ(bad.count(6), 70000u);
+  EXPECT_EQ(bad.cellsOf(6), long_run);
 
   for (const int threads : {1, 3}) {
     const MatchCounts counts = countSharedCells(regions, threads);
@@ -715,10 +740,7 @@ TEST(SensedRegions, SharedCellsMatchABruteForceCountAcrossTilesIn2DAnd3D) {
     }
     ObservationRegions regions;
     regions.planar = planar;
-    for (const auto& region : cells) {
-      regions.cells.insert(regions.cells.end(), region.begin(), region.end());
-      regions.offsets.push_back(regions.cells.size());
-    }
+    for (const auto& region : cells) regions.append(std::vector<std::uint64_t>(region.begin(), region.end()));
     for (const int threads : {1, 3}) {
       const MatchCounts counts = countSharedCells(regions, threads);
       ASSERT_EQ(counts.rows.size(), std::size_t(n));

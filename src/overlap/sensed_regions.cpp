@@ -3,14 +3,11 @@
 #include "cell_tiles.h"
 #include "region_cells.h"
 
+#include "obsgroup/common/freed_memory.h"
 #include "obsgroup/common/parallel_for.h"
 #include "obsgroup/common/invalid_observation.h"
 
 #include <omp.h>
-
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -33,19 +30,6 @@ using namespace region_cells;
 /// apart along the route rather than the same cache lines, but at least
 /// eight chunks a thread to share the work.
 int countingChunk(int n, int threads) { return std::max(16, std::min(256, n / (8 * std::max(1, threads)))); }
-
-/// Hands the pages of `bytes` of small blocks just freed (the regions' lists:
-/// a few kilobytes each, kept by malloc for reuse) back to the system, so
-/// that they do not add to every later stage's resident memory. Only for
-/// large amounts: trimming walks the heap.
-constexpr std::size_t kTrimBytes = std::size_t(64) << 20;
-void returnFreedMemory(std::size_t bytes) {
-#if defined(__GLIBC__)
-  if (bytes >= kTrimBytes) malloc_trim(0);
-#else
-  (void)bytes;
-#endif
-}
 
 /// The plane cells occupied in the evidence of all observations: at least
 /// params.min_observations observations have a point in the cell, and at
@@ -142,28 +126,113 @@ Eigen::Vector3d ObservationRegions::cellCentre(std::uint64_t key) const {
 }
 
 bool ObservationRegions::planeBounds(Eigen::Vector3d& lowest, Eigen::Vector3d& highest) const {
-  if (cells.empty()) return false;
-  // A cell's x and y coordinates are fields of its key; the centre grows with each.
+  if (empty()) return false;
+  // A cell's x and y coordinates are fields of its key; the centre grows with
+  // each. A run varies only the lowest field (y of a plane cell, z of a voxel).
   const int x_shift = planar ? 32 : 42, y_shift = planar ? 0 : 21;
   const std::uint64_t y_mask = planar ? 0xffffffffu : (std::uint64_t(1) << 21) - 1;
   std::uint64_t x_lo = ~std::uint64_t(0), x_hi = 0, y_lo = ~std::uint64_t(0), y_hi = 0;
-  for (std::uint64_t key : cells) {
-    const std::uint64_t x = key >> x_shift, y = (key >> y_shift) & y_mask;
-    x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x);
-    y_lo = std::min(y_lo, y), y_hi = std::max(y_hi, y);
+  for (std::size_t r = 0; r < run_start_.size(); ++r) {
+    const std::uint64_t first = run_start_[r], last = first + run_length_[r] - 1;
+    x_lo = std::min(x_lo, first >> x_shift), x_hi = std::max(x_hi, first >> x_shift);
+    y_lo = std::min(y_lo, (first >> y_shift) & y_mask), y_hi = std::max(y_hi, (last >> y_shift) & y_mask);
   }
-  const std::uint64_t z = planar ? 0 : cells.front() & ((std::uint64_t(1) << 21) - 1);
+  const std::uint64_t first = firstKey();
+  const std::uint64_t z = planar ? 0 : first & ((std::uint64_t(1) << 21) - 1);
   lowest = cellCentre(x_lo << x_shift | y_lo << y_shift | z);
   highest = cellCentre(x_hi << x_shift | y_hi << y_shift | z);
   return true;
 }
 
+void ObservationRegions::appendRuns(const std::uint64_t* starts, const std::uint16_t* lengths, std::size_t runs) {
+  std::size_t cells = 0;
+  for (std::size_t r = 0; r < runs; ++r) {
+    const bool fits = lengths[r] > 0 && starts[r] <= ~std::uint64_t(0) - (lengths[r] - 1);
+    // Canonical runs: a gap before the next, unless the last one was full.
+    const std::uint64_t last_before = r == 0 ? 0 : starts[r - 1] + (lengths[r - 1] - 1);
+    const bool after =
+        r == 0 || (starts[r] > last_before && (starts[r] != last_before + 1 || lengths[r - 1] == 0xffff));
+    if (!fits || !after)
+      throw std::invalid_argument("ObservationRegions: the cells of observation " + std::to_string(size()) +
+                                  " must be ascending and distinct");
+    cells += lengths[r];
+  }
+  run_start_.insert(run_start_.end(), starts, starts + runs);
+  run_length_.insert(run_length_.end(), lengths, lengths + runs);
+  run_offsets_.push_back(run_start_.size());
+  cell_offsets_.push_back(cell_offsets_.back() + cells);
+}
+
 namespace {
 
-/// Each observation's region as its own list of keys (ascending), and
-/// whether they are plane cells.
+/// Runs of consecutive keys, as ObservationRegions keeps them: one region.
+struct RunList {
+  std::vector<std::uint64_t> start;
+  std::vector<std::uint16_t> length;
+  std::size_t cells = 0;
+
+  /// From keys ascending and distinct; false when they are not.
+  bool assign(const std::uint64_t* begin, const std::uint64_t* end) {
+    start.clear();
+    length.clear();
+    cells = std::size_t(end - begin);
+    for (const std::uint64_t* key = begin; key != end; ++key) {
+      if (key != begin && *key <= key[-1]) return false;
+      if (!length.empty() && *key == start.back() + length.back() && length.back() < 0xffff) {
+        ++length.back();
+      } else {
+        start.push_back(*key);
+        length.push_back(1);
+      }
+    }
+    start.shrink_to_fit();
+    length.shrink_to_fit();
+    return true;
+  }
+  template <typename F>
+  void forEachCell(F&& f) const {
+    for (std::size_t r = 0; r < start.size(); ++r)
+      for (std::uint64_t key = start[r], last = key + length[r]; key != last; ++key) f(key);
+  }
+  std::size_t bytes() const { return start.capacity() * sizeof(std::uint64_t) + length.capacity() * sizeof(std::uint16_t); }
+};
+
+}  // namespace
+
+void ObservationRegions::append(const std::uint64_t* begin, const std::uint64_t* end) {
+  RunList runs;
+  if (!runs.assign(begin, end))
+    throw std::invalid_argument("ObservationRegions: the cells of observation " + std::to_string(size()) +
+                                " must be ascending and distinct");
+  appendRuns(runs.start.data(), runs.length.data(), runs.start.size());
+}
+
+std::size_t ObservationRegions::bytes() const {
+  return run_start_.capacity() * sizeof(std::uint64_t) + run_length_.capacity() * sizeof(std::uint16_t) +
+         (run_offsets_.capacity() + cell_offsets_.capacity()) * sizeof(std::size_t);
+}
+
+std::vector<std::uint64_t> ObservationRegions::cellsOf(int i) const {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(count(i));
+  forEachCell(i, [&keys](std::uint64_t key) { keys.push_back(key); });
+  return keys;
+}
+
+std::uint64_t ObservationRegions::firstKey() const { return run_start_.empty() ? 0 : run_start_.front(); }
+
+bool ObservationRegions::operator==(const ObservationRegions& other) const {
+  return planar == other.planar && cell_size == other.cell_size && phase == other.phase &&
+         run_start_ == other.run_start_ && run_length_ == other.run_length_ && run_offsets_ == other.run_offsets_;
+}
+
+namespace {
+
+/// Each observation's region as its own runs of keys, and whether they are
+/// plane cells. Encoded as each region is found, so that the lists of keys
+/// (8 bytes a cell) are never all held at once.
 struct RegionLists {
-  std::vector<std::vector<std::uint64_t>> cells;
+  std::vector<RunList> cells;
   bool planar = true;
   double cell_size = 1.0;
   Eigen::Vector3d phase = Eigen::Vector3d::Constant(0.5);
@@ -192,25 +261,29 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   std::vector<std::uint64_t> occupied;
   if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, cells, regions.planar, threads);
   const OccupancyGrid grid(occupied);
-  std::vector<std::vector<std::uint64_t>>& per_observation = regions.cells;
+  std::vector<RunList>& per_observation = regions.cells;
   per_observation.resize(n);
   struct Scratch {
     RegionMarker<2> marker2, own_surfaces;
     RegionMarker<3> marker3;
     OccupancyGrid::Reader reader;
     ViewWidths widths;
+    std::vector<std::uint64_t> keys;
   };
   parallelForWithScratch(
-      n, threads, 8, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(grid), {}}; },
+      n, threads, 8, [&] { return Scratch{{}, {}, {}, OccupancyGrid::Reader(grid), {}, {}}; },
       [&](std::size_t i, Scratch& s) {
         if (interruptRequested(interrupt)) return;
+        s.keys.clear();
         if (model == SensedSpaceModel::Visibility)
           visibilityOf(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, regions.planar, s.reader,
-                       s.own_surfaces, s.marker2, s.widths, per_observation[i]);
+                       s.own_surfaces, s.marker2, s.widths, s.keys);
         else if (volumetric)
-          freeSpaceOf<3>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker3, per_observation[i]);
+          freeSpaceOf<3>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker3, s.keys);
         else
-          freeSpaceOf<2>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker2, per_observation[i]);
+          freeSpaceOf<2>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker2, s.keys);
+        // The markers give each key once, ascending.
+        per_observation[i].assign(s.keys.data(), s.keys.data() + s.keys.size());
       });
   throwIfInterrupted(interrupt);
   regions.planar = !volumetric;
@@ -228,17 +301,12 @@ struct SharedCells {
   std::vector<std::uint32_t> watchers;
 };
 
-/// One observation's cells: keys, ascending and distinct.
-struct KeySpan {
-  const std::uint64_t* begin = nullptr;
-  const std::uint64_t* end = nullptr;
-};
-
-/// Builds the index from keys_of(i) (a KeySpan for observation i) without
-/// sorting the entries: the cells are counted per tile slot, numbered, and
+/// Builds the index from for_each_key(i, f) (f called with each key of
+/// observation i's region, ascending) without sorting the entries: the cells are counted per tile slot, numbered, and
 /// each observation is written into its cells' lists. Four bytes per entry.
-template <typename KeysOf>
-SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, const InterruptFlag* interrupt) {
+template <typename ForEachKey>
+SharedCells indexSharedCells(int n, bool planar, ForEachKey&& for_each_key, int threads,
+                             const InterruptFlag* interrupt) {
   SharedCells shared(planar);
   CellTiles& tiles = shared.tiles;
   // The tiles each observation touches, added in observation order.
@@ -246,11 +314,10 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
     std::vector<std::vector<std::uint64_t>> tiles_of(n);
     parallelFor(n, threads, 64, [&](std::size_t i) {
       auto& touched = tiles_of[i];
-      const KeySpan keys = keys_of(int(i));
-      for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
-        const std::uint64_t tile = tiles.tileOf(*key);
+      for_each_key(int(i), [&](std::uint64_t key) {
+        const std::uint64_t tile = tiles.tileOf(key);
         if (touched.empty() || touched.back() != tile) touched.push_back(tile);
-      }
+      });
       std::sort(touched.begin(), touched.end());
       touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     });
@@ -263,9 +330,7 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   SlotCounters watchers_of_slot(tiles.slots());
   const auto with_lookup = [&tiles] { return CellTiles::Lookup(tiles); };
   parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
-    const KeySpan keys = keys_of(int(i));
-    for (const std::uint64_t* key = keys.begin; key != keys.end; ++key)
-      watchers_of_slot.increment(lookup.existingSlot(*key));
+    for_each_key(int(i), [&](std::uint64_t key) { watchers_of_slot.increment(lookup.existingSlot(key)); });
   });
   throwIfInterrupted(interrupt);
   // Cells numbered in slot order; each slot's counter then counts the
@@ -285,12 +350,11 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
   shared.cell_start.push_back(total);
   shared.watchers.resize(total);
   parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
-    const KeySpan keys = keys_of(int(i));
-    for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
-      const std::size_t slot = lookup.existingSlot(*key);
+    for_each_key(int(i), [&](std::uint64_t key) {
+      const std::size_t slot = lookup.existingSlot(key);
       shared.watchers[shared.cell_start[shared.cell_of_slot[slot]] + watchers_of_slot.increment(slot)] =
           std::uint32_t(i);
-    }
+    });
   });
   throwIfInterrupted(interrupt);
   return shared;
@@ -300,10 +364,10 @@ SharedCells indexSharedCells(int n, bool planar, KeysOf&& keys_of, int threads, 
 /// many: integer counts, the same whatever the order of a cell's watchers.
 /// release(i) is called once observation i's keys are no longer needed, so
 /// that lists can be freed as the rows are counted.
-template <typename KeysOf, typename Release>
-MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release, int threads,
+template <typename ForEachKey, typename Release>
+MatchCounts countShared(int n, bool planar, ForEachKey&& for_each_key, Release&& release, int threads,
                         const InterruptFlag* interrupt) {
-  const SharedCells cells = indexSharedCells(n, planar, keys_of, threads, interrupt);
+  const SharedCells cells = indexSharedCells(n, planar, for_each_key, threads, interrupt);
   MatchCounts out;
   out.rows.resize(n);
   std::uint64_t pairs = 0, tests = 0;
@@ -315,16 +379,15 @@ MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release,
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
       if (interruptRequested(interrupt)) continue;
-      const KeySpan keys = keys_of(i);
-      for (const std::uint64_t* key = keys.begin; key != keys.end; ++key) {
+      for_each_key(i, [&](std::uint64_t key) {
         // The slot exists: indexSharedCells added it for this very key.
-        const std::uint32_t c = cells.cell_of_slot[lookup.slot(*key)];
+        const std::uint32_t c = cells.cell_of_slot[lookup.slot(key)];
         for (std::size_t w = cells.cell_start[c]; w < cells.cell_start[c + 1]; ++w) {
           const std::uint32_t j = cells.watchers[w];
           if (shared[j]++ == 0) touched.push_back(int(j));
         }
         tests += cells.cell_start[c + 1] - cells.cell_start[c];
-      }
+      });
       release(i);
       std::sort(touched.begin(), touched.end());
       auto& row = out.rows[i];
@@ -342,14 +405,14 @@ MatchCounts countShared(int n, bool planar, KeysOf&& keys_of, Release&& release,
   return out;
 }
 
-/// countShared over per-observation lists, freeing each once indexed.
+/// countShared over per-observation lists, freeing each once counted.
 MatchCounts countShared(RegionLists& lists, int threads, const InterruptFlag* interrupt) {
   std::size_t bytes = 0;
-  for (const auto& list : lists.cells) bytes += list.size() * sizeof(std::uint64_t);
+  for (const auto& list : lists.cells) bytes += list.bytes();
   MatchCounts counts = countShared(
       int(lists.cells.size()), lists.planar,
-      [&lists](int i) { return KeySpan{lists.cells[i].data(), lists.cells[i].data() + lists.cells[i].size()}; },
-      [&lists](int i) { std::vector<std::uint64_t>().swap(lists.cells[i]); }, threads, interrupt);
+      [&lists](int i, auto&& f) { lists.cells[std::size_t(i)].forEachCell(f); },
+      [&lists](int i) { lists.cells[std::size_t(i)] = RunList(); }, threads, interrupt);
   returnFreedMemory(bytes);
   return counts;
 }
@@ -382,15 +445,13 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   regions.planar = lists.planar;
   regions.cell_size = lists.cell_size;
   regions.phase = lists.phase;
-  for (const auto& list : lists.cells) regions.offsets.push_back(regions.offsets.back() + list.size());
-  regions.cells.reserve(regions.offsets.back());
   // The lists are handed back as they are copied, so that the regions are
   // not resident twice at the end.
   std::size_t freed = 0;
   for (auto& list : lists.cells) {
-    regions.cells.insert(regions.cells.end(), list.begin(), list.end());
-    freed += list.size() * sizeof(std::uint64_t);
-    std::vector<std::uint64_t>().swap(list);
+    regions.appendRuns(list.start.data(), list.length.data(), list.start.size());
+    freed += list.bytes();
+    list = RunList();
     if (freed >= kTrimBytes) {
       returnFreedMemory(freed);
       freed = 0;
@@ -405,27 +466,16 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
                                    int threads, const InterruptFlag* interrupt) {
   RegionLists lists = regionLists(model, world, sensor_origins, params, threadCount(threads), interrupt);
   std::vector<std::size_t> sizes(lists.cells.size());
-  for (std::size_t i = 0; i < sizes.size(); ++i) sizes[i] = lists.cells[i].size();
+  for (std::size_t i = 0; i < sizes.size(); ++i) sizes[i] = lists.cells[i].cells;
   return assembleOverlap(countShared(lists, threadCount(threads), interrupt), sizes);
 }
 
 
 MatchCounts countSharedCells(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
-  const int n = regions.size();
-  threads = threadCount(threads);
-  if (regions.offsets.empty() || regions.offsets.front() != 0 || regions.offsets.back() != regions.cells.size() ||
-      !std::is_sorted(regions.offsets.begin(), regions.offsets.end()))
-    throw std::invalid_argument("countSharedCells: offsets must run from 0 to the number of cells, ascending");
-  for (int i = 0; i < n; ++i)
-    for (std::size_t k = regions.offsets[i] + 1; k < regions.offsets[i + 1]; ++k)
-      if (regions.cells[k] <= regions.cells[k - 1])
-        throw std::invalid_argument("countSharedCells: the cells of observation " + std::to_string(i) +
-                                    " must be ascending and distinct");
-  const std::uint64_t* cells = regions.cells.data();
+  // ObservationRegions::append refused keys out of order: each region's are ascending and distinct.
   return countShared(
-      n, regions.planar,
-      [&](int i) { return KeySpan{cells + regions.offsets[i], cells + regions.offsets[i + 1]}; }, [](int) {}, threads,
-      interrupt);
+      regions.size(), regions.planar, [&regions](int i, auto&& f) { regions.forEachCell(i, f); }, [](int) {},
+      threadCount(threads), interrupt);
 }
 
 OverlapResult regionOverlap(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {

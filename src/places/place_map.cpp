@@ -69,9 +69,9 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) 
   const double cs = regions.cell_size;
   GridFrame f;
   f.grid.resolution = cs;
-  if (regions.cells.empty()) return f;
+  if (regions.empty()) return f;
   // Cell edges where the regions' are: a corner half a cell below a region cell's centre.
-  const Eigen::Vector3d first = regions.cellCentre(regions.cells.front());
+  const Eigen::Vector3d first = regions.cellCentre(regions.firstKey());
   f.base = Eigen::Vector2d(first.x() - cs / 2, first.y() - cs / 2);
   // The extreme cells by their keys: cellX and cellY grow with a cell's coordinates.
   Eigen::Vector3d lowest, highest;
@@ -155,7 +155,7 @@ class FloorCellOfKey {
   FloorCellOfKey(const ObservationRegions& regions, const GridFrame& f)
       : x_shift_(regions.planar ? 32 : 42), y_shift_(regions.planar ? 0 : 21),
         y_mask_(regions.planar ? 0xffffffffu : (std::uint64_t(1) << 21) - 1), grid_(f.grid) {
-    const std::uint64_t first = regions.cells.empty() ? 0 : regions.cells.front();
+    const std::uint64_t first = regions.firstKey();
     x0_ = std::int64_t(first >> x_shift_) + f.first.x();
     y0_ = std::int64_t((first >> y_shift_) & y_mask_) + f.first.y();
   }
@@ -185,12 +185,12 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCell
     touched.clear();
     for (int i : groups[g]) {
       ++stamp;
-      for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
-        const std::size_t c = cell_of(regions.cells[k]);
-        if (seen_by[c] == stamp) continue;  // another voxel of this observation above the cell
+      regions.forEachCell(i, [&](std::uint64_t key) {
+        const std::size_t c = cell_of(key);
+        if (seen_by[c] == stamp) return;  // another voxel of this observation above the cell
         seen_by[c] = stamp;
         if (count[c]++ == 0) touched.push_back(std::uint32_t(c));
-      }
+      });
     }
     const std::uint64_t size = groups[g].size();
     for (std::uint32_t c : touched) {
@@ -640,8 +640,10 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   const std::vector<char> crossed = crossedCells(f, world, sensor_origins);
   const FloorCellOfKey cell_of(regions, f);
   map.occupancy.assign(cells, Occupancy::Unknown);
-  for (std::uint64_t key : regions.cells)
-    if (const std::size_t k = cell_of(key); crossed[k]) map.occupancy[k] = Occupancy::Free;
+  for (int i = 0; i < n; ++i)
+    regions.forEachCell(i, [&](std::uint64_t key) {
+      if (const std::size_t k = cell_of(key); crossed[k]) map.occupancy[k] = Occupancy::Free;
+    });
   for (int i = 0; i < n; ++i)
     for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
       if (isObstacle(*p, sensor_origins[i], planar, options))
@@ -656,7 +658,7 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   map.places.resize(groups.size());
   std::vector<std::size_t> cell_count(groups.size(), 0);
   std::vector<Eigen::Vector2d> centre_sum(groups.size(), Eigen::Vector2d::Zero());
-  std::vector<std::vector<char>> touches(groups.size(), std::vector<char>(groups.size(), 0));
+  std::vector<std::pair<int, int>> touches;  // (place, neighbour), both ways; a matrix would be quadratic in places
   for (int j = 0; j < g.height; ++j)
     for (int i = 0; i < g.width; ++i) {
       const int l = label[g.index(i, j)];
@@ -665,13 +667,15 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
       centre_sum[l] += g.cellCentre(i, j);
       if (i + 1 < g.width) {
         const int r = label[g.index(i + 1, j)];
-        if (r != kNone && r != l) touches[l][r] = touches[r][l] = 1;
+        if (r != kNone && r != l) touches.insert(touches.end(), {{l, r}, {r, l}});
       }
       if (j + 1 < g.height) {
         const int u = label[g.index(i, j + 1)];
-        if (u != kNone && u != l) touches[l][u] = touches[u][l] = 1;
+        if (u != kNone && u != l) touches.insert(touches.end(), {{l, u}, {u, l}});
       }
     }
+  std::sort(touches.begin(), touches.end());
+  touches.erase(std::unique(touches.begin(), touches.end()), touches.end());
   const std::vector<std::size_t> deepest = deepestCells(g, label, groups.size());
   for (std::size_t k = 0; k < groups.size(); ++k) {
     Place& place = map.places[k];
@@ -680,8 +684,8 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
     place.members = groups[k];
     place.area_m2 = double(cell_count[k]) * cell_area;
     if (cell_count[k] > 0) place.centroid = centre_sum[k] / double(cell_count[k]);
-    for (std::size_t o = 0; o < groups.size(); ++o)
-      if (touches[k][o]) place.neighbours.push_back(place_ids[o]);
+    const auto first = std::lower_bound(touches.begin(), touches.end(), std::make_pair(int(k), 0));
+    for (auto t = first; t != touches.end() && t->first == int(k); ++t) place.neighbours.push_back(place_ids[t->second]);
     std::sort(place.neighbours.begin(), place.neighbours.end());
   }
   for (std::size_t p = 0; p < pieces.cells.size(); ++p) {

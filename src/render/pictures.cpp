@@ -267,14 +267,14 @@ void fillSquare(const View& v, int cx, int cy, int half, std::uint32_t argb, uns
 void tintRegions(const ObservationRegions& regions, const Partition& partition, const std::vector<int>& colours,
                  const View& v, unsigned char* data, int stride) {
   std::vector<std::pair<std::uint64_t, int>> cells;  // (plane cell, group)
-  cells.reserve(regions.cells.size());
+  cells.reserve(regions.totalCells());
   for (int i = 0; i < regions.size(); ++i)
-    for (std::size_t k = regions.offsets[i]; k < regions.offsets[i + 1]; ++k) {
-      const Eigen::Vector3d c = regions.cellCentre(regions.cells[k]);
+    regions.forEachCell(i, [&](std::uint64_t key) {
+      const Eigen::Vector3d c = regions.cellCentre(key);
       const std::uint64_t px = std::uint64_t(std::uint32_t(std::lround(v.px(c.x()))));
       const std::uint64_t py = std::uint64_t(std::uint32_t(std::lround(v.py(c.y()))));
       cells.emplace_back((px << 32) | py, partition.group_of[i]);
-    }
+    });
   std::sort(cells.begin(), cells.end());
   const int half = std::max(1, int(std::ceil(regions.cell_size * v.scale / 2)));
   for (std::size_t a = 0; a < cells.size();) {
