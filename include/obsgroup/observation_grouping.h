@@ -139,8 +139,14 @@ class ObservationGrouping {
 
   /// The weight matrix W of the last compute() (diagonal as configured).
   const WeightMatrix& getWeightMatrix() const { return W_; }
-  /// Pi, Psi and work statistics of the last compute().
+  /// Pi, Psi and work statistics of the last compute() (without
+  /// setKeepOverlapMatrix: the statistics only, Pi and the pairs empty).
   const OverlapResult& getOverlap() const { return overlap_result_; }
+  /// Keep Pi and the pairs of Psi after W is built from them (on by
+  /// default). Off, compute() frees them once W stands: on a large run they
+  /// take twice W's memory and nothing after the graph needs them.
+  void setKeepOverlapMatrix(bool keep) { keep_overlap_matrix_ = keep; }
+  bool getKeepOverlapMatrix() const { return keep_overlap_matrix_; }
   /// The overlap stage as configured (model, voxel leaf, regions, threads),
   /// e.g. to compute the observations' regions for a picture.
   SensedSpaceOverlap<PointT> getSensedSpaceOverlap() const;
@@ -174,6 +180,7 @@ class ObservationGrouping {
   ProgressCallback progress_;
   const InterruptFlag* interrupt_ = nullptr;
   OverlapResult overlap_result_;
+  bool keep_overlap_matrix_ = true;
   WeightMatrix W_;
   bool keep_world_points_ = false;
   WorldPoints world_;

@@ -19,6 +19,7 @@
 
 #include <obsgroup/maps/local_map_builder.h>
 #include <obsgroup/maps/topological_map.h>
+#include <obsgroup/common/freed_memory.h>
 #include <obsgroup/common/parallel_for.h>
 #include <obsgroup/observation_grouping.h>
 #include <obsgroup/io/pose_file.h>
@@ -160,6 +161,7 @@ void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& g
   grouping.setParameters(args.method);
   grouping.setKeepWorldPoints(true);  // the places and map.png are drawn from them
   grouping.setKeepRegions(true);      // and cut from these
+  grouping.setKeepOverlapMatrix(false);  // W is all the rest needs
 }
 
 /// Groups the observations at once: the overlap, W and the partition (sec. II-III).
@@ -186,7 +188,7 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
   // matched on its own); a user counts a pair once.
   out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated / 2},
                     {"point_tests", overlap.point_tests},
-                    {"edges", overlap.pairs.size()}};
+                    {"edges", edgeCount(out.W)}};
   const auto& t = grouping.getTimings();
   out.timing_s = {{"overlap", t.overlap_s}, {"graph", t.graph_s}, {"partition", t.partition_s}};
 }
@@ -731,6 +733,7 @@ AnyInput readCarmen(const PartitionArgs& args) {
                       {"point_type", io::toString(io::PointKind::XYZ)}};
   input.warnings = std::move(log.warnings);
   log.scans = {};  // the ranges are in the clouds now: free them for the rest of the run
+  returnFreedMemory(kTrimBytes);
   input.load_s = secondsSince(start);
   return InputObservations<pcl::PointXYZ>{std::move(observations), std::move(input)};
 }

@@ -63,6 +63,10 @@ Partition ObservationGrouping<PointT>::compute() {
   timings_.overlap_s = seconds_since(start);
   start = Clock::now();
   W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, params_.diagonal_weight);
+  if (!keep_overlap_matrix_) {
+    overlap_result_.match_ratio = decltype(overlap_result_.match_ratio)();
+    overlap_result_.pairs = {};
+  }
   timings_.graph_s = seconds_since(start);
   start = Clock::now();
   Partition partition = recursivePartition(W_, getPartitionOptions());

@@ -2,6 +2,7 @@
 
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/overlap/shared_grid_matcher.h"
+#include "obsgroup/common/freed_memory.h"
 #include "obsgroup/common/parallel_for.h"
 
 #include "obsgroup/cloud/finite_points.h"
@@ -81,6 +82,10 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
     }
   });
   world.appendAll(per_observation, threads);
+  std::size_t bytes = 0;
+  for (const auto& points : per_observation) bytes += points.capacity() * sizeof(Eigen::Vector3f);
+  per_observation = {};
+  returnFreedMemory(bytes);  // the copies, now in `world`, would stay resident
   return world;
 }
 
