@@ -177,6 +177,30 @@ void expectPlaces(const fs::path& out, const nlohmann::json& partition) {
   for (const auto& p : labelled.points) labels.insert(int(p.label));
   EXPECT_TRUE(std::includes(id_set.begin(), id_set.end(), labels.begin(), labels.end()));
   EXPECT_FALSE(labels.empty());
+  // Map by map in group order: each local map's points moved by its pose
+  // (local_maps/poses.txt), labelled with its place's id.
+  std::ifstream poses(out / "local_maps" / "poses.txt");
+  std::string line;
+  std::getline(poses, line);  // the comment
+  std::size_t at = 0;
+  for (std::size_t g = 0; g < ids.size(); ++g) {
+    std::size_t group = 0;
+    double x, y, z, qx, qy, qz, qw;
+    ASSERT_TRUE(poses >> group >> x >> y >> z >> qx >> qy >> qz >> qw);
+    ASSERT_EQ(group, g);
+    const Eigen::Isometry3f pose = (Eigen::Translation3d(x, y, z) * Eigen::Quaterniond(qw, qx, qy, qz)).cast<float>();
+    char name[32];
+    std::snprintf(name, sizeof name, "group_%03zu.pcd", g);
+    pcl::PointCloud<pcl::PointXYZ> map;
+    ASSERT_EQ(pcl::io::loadPCDFile((out / "local_maps" / name).string(), map), 0) << name;
+    ASSERT_LE(at + map.size(), labelled.size());
+    for (const auto& p : map.points) {
+      const pcl::PointXYZL& q = labelled.points[at++];
+      EXPECT_EQ(int(q.label), ids[g].get<int>());
+      EXPECT_LT((q.getVector3fMap() - pose * p.getVector3fMap()).norm(), 1e-4f) << name;
+    }
+  }
+  EXPECT_EQ(at, labelled.size());
 }
 
 void expectAllOutputs(const fs::path& out, const nlohmann::json& partition) {

@@ -5,7 +5,11 @@
 
 #include "obsgroup/common/parallel_for.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 
@@ -58,21 +62,49 @@ template <typename PointT>
 std::size_t writeLabelledMap(const OutputFolder& out, const std::vector<LocalMap<PointT>>& maps,
                              const std::vector<int>& place_ids) {
   using Labelled = decltype(labelledPoint(PointT{}, Eigen::Isometry3f::Identity(), 0));
-  pcl::PointCloud<Labelled> cloud;
   std::size_t total = 0;
   for (const auto& map : maps) total += map.cloud->size();
-  cloud.reserve(total);
-  for (std::size_t g = 0; g < maps.size(); ++g) {
-    const Eigen::Isometry3f pose = maps[g].frame.pose.template cast<float>();
-    const auto label = std::uint32_t(place_ids.at(g));
-    for (const PointT& p : maps[g].cloud->points) cloud.push_back(labelledPoint(p, pose, label));
-  }
-  out.write("map_labelled.pcd", [&cloud](const std::string& temporary) {
-    const int status = cloud.empty() ? pcl::io::savePCDFileASCII(temporary, cloud)
-                                     : pcl::io::savePCDFileBinaryCompressed(temporary, cloud);
-    if (status < 0) throw std::runtime_error(temporary + ": cannot write");
+  if (total > std::size_t(std::numeric_limits<int>::max()))
+    throw std::runtime_error("map_labelled.pcd: more than 2^31 - 1 points, beyond what a PCD header counts");
+  // Written map by map in PCL's binary layout (each field packed, padding
+  // left out, as PCDWriter::writeBinary writes it), never as one cloud of
+  // the whole map: that cloud and a compressed copy would double the run's
+  // memory at scale (docs/performance.md).
+  std::vector<pcl::PCLPointField> fields;
+  std::size_t packed = 0;
+  for (const pcl::PCLPointField& field : pcl::getFields<Labelled>())
+    if (field.name != "_") {
+      fields.push_back(field);
+      packed += std::size_t(std::max<int>(1, int(field.count))) * std::size_t(pcl::getFieldSize(field.datatype));
+    }
+  out.write("map_labelled.pcd", [&](const std::string& temporary) {
+    if (total == 0) {  // PCL refuses to write an empty cloud in binary; an ASCII header with 0 points is valid.
+      if (pcl::io::savePCDFileASCII(temporary, pcl::PointCloud<Labelled>()) < 0)
+        throw std::runtime_error(temporary + ": cannot write");
+      return;
+    }
+    std::ofstream file(temporary, std::ios::binary);
+    file << pcl::PCDWriter::generateHeader(pcl::PointCloud<Labelled>(), int(total)) << "DATA binary\n";
+    std::vector<char> bytes;
+    for (std::size_t g = 0; g < maps.size() && file; ++g) {
+      const Eigen::Isometry3f pose = maps[g].frame.pose.template cast<float>();
+      const auto label = std::uint32_t(place_ids.at(g));
+      bytes.resize(maps[g].cloud->size() * packed);
+      char* to = bytes.data();
+      for (const PointT& p : maps[g].cloud->points) {
+        const Labelled point = labelledPoint(p, pose, label);
+        for (const pcl::PCLPointField& field : fields) {
+          const std::size_t size = std::size_t(std::max<int>(1, int(field.count))) * pcl::getFieldSize(field.datatype);
+          std::memcpy(to, reinterpret_cast<const char*>(&point) + field.offset, size);
+          to += size;
+        }
+      }
+      file.write(bytes.data(), std::streamsize(bytes.size()));
+    }
+    file.close();
+    if (!file) throw std::runtime_error(temporary + ": cannot write");
   });
-  return cloud.size();
+  return total;
 }
 
 template std::size_t writeLocalMaps(const OutputFolder&, const std::vector<LocalMap<pcl::PointXYZ>>&, int);
