@@ -89,6 +89,7 @@ TEST(Places, TheRegionsTheGroupingKeepsAreThoseItWouldComputeAndGiveTheSameGroup
   const auto observations = test::simulate<pcl::PointXYZ>(office.plan, office.route, sim::laser360());
   ObservationGrouping<pcl::PointXYZ> plain, keeping;
   keeping.setKeepRegions(true);
+  keeping.setKeepOverlapMatrix(false);
   for (const auto& o : observations) {
     plain.addObservation(o.cloud, o.pose);
     keeping.addObservation(o.cloud, o.pose);
@@ -96,6 +97,13 @@ TEST(Places, TheRegionsTheGroupingKeepsAreThoseItWouldComputeAndGiveTheSameGroup
   EXPECT_EQ(plain.compute().groups, keeping.compute().groups);
   EXPECT_EQ(plain.getWeightMatrix().toDense(), keeping.getWeightMatrix().toDense());
   EXPECT_EQ(plain.getRegions().size(), 0);  // not kept unless asked
+  // Pi and the pairs are freed once W stands, unless kept (the default); the statistics stay.
+  EXPECT_GT(plain.getOverlap().match_ratio.nonZeros(), 0);
+  EXPECT_FALSE(plain.getOverlap().pairs.empty());
+  EXPECT_EQ(keeping.getOverlap().match_ratio.nonZeros(), 0);
+  EXPECT_TRUE(keeping.getOverlap().pairs.empty());
+  EXPECT_EQ(keeping.getOverlap().points_per_observation, plain.getOverlap().points_per_observation);
+  EXPECT_EQ(keeping.getOverlap().pairs_evaluated, plain.getOverlap().pairs_evaluated);
   const ObservationRegions again =
       keeping.getSensedSpaceOverlap().computeRegions(observations, keeping.getSensedSpaceOverlap().toWorld(observations));
   EXPECT_TRUE(keeping.getRegions() == again);
