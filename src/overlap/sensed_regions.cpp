@@ -190,9 +190,8 @@ struct RunList {
     return true;
   }
   template <typename F>
-  void forEachCell(F&& f) const {
-    for (std::size_t r = 0; r < start.size(); ++r)
-      for (std::uint64_t key = start[r], last = key + length[r]; key != last; ++key) f(key);
+  void forEachRun(F&& f) const {
+    for (std::size_t r = 0; r < start.size(); ++r) f(start[r], std::size_t(length[r]));
   }
   std::size_t bytes() const { return start.capacity() * sizeof(std::uint64_t) + length.capacity() * sizeof(std::uint16_t); }
 };
@@ -290,84 +289,109 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   return regions;
 }
 
-/// Which observations hold each cell: cell c is held by
-/// watchers[cell_start[c], cell_start[c+1]) (in no particular order); the
-/// cell of a key is cell_of_slot[its slot in tiles].
-struct SharedCells {
-  explicit SharedCells(bool planar) : tiles(planar) {}
-  CellTiles tiles;
-  std::vector<std::uint32_t> cell_of_slot;
-  std::vector<std::size_t> cell_start;
-  std::vector<std::uint32_t> watchers;
+/// A run's piece within one segment of 64 consecutive keys (a stretch of a
+/// column of plane cells, of a stack of voxels): which observation holds it
+/// and its first and last key's offsets in the segment.
+struct SegmentPiece {
+  std::uint32_t observation;
+  std::uint8_t first, last;
 };
 
-/// Builds the index from for_each_key(i, f) (f called with each key of
-/// observation i's region, ascending) without sorting the entries: the cells are counted per tile slot, numbered, and
-/// each observation is written into its cells' lists. Four bytes per entry.
-template <typename ForEachKey>
-SharedCells indexSharedCells(int n, bool planar, ForEachKey&& for_each_key, int threads,
-                             const InterruptFlag* interrupt) {
-  SharedCells shared(planar);
-  CellTiles& tiles = shared.tiles;
-  // The tiles each observation touches, added in observation order.
+constexpr int kSegmentBits = 6;
+
+/// f(segment, first offset, last offset) for each piece of a run.
+template <typename F>
+void forEachPiece(std::uint64_t start, std::size_t length, F&& f) {
+  const std::uint64_t last_key = start + (length - 1);
+  for (std::uint64_t segment = start >> kSegmentBits; segment <= last_key >> kSegmentBits; ++segment) {
+    const std::uint64_t base = segment << kSegmentBits;
+    const std::uint64_t lo = std::max(start, base), hi = std::min(last_key, base + ((1u << kSegmentBits) - 1));
+    f(segment, std::uint8_t(lo - base), std::uint8_t(hi - base));
+  }
+}
+
+/// Which observations hold each segment, piece by piece: segment s (the
+/// s-th of `segments`, ascending) is held by pieces[start[s], start[s+1]).
+/// Indexing runs instead of cells keeps a few bytes per run where a cell
+/// index would keep four per cell (docs/performance.md).
+struct SharedSegments {
+  std::vector<std::uint64_t> segments;
+  std::vector<std::size_t> start;
+  std::vector<SegmentPiece> pieces;
+
+  std::size_t indexOf(std::uint64_t segment) const {
+    return std::size_t(std::lower_bound(segments.begin(), segments.end(), segment) - segments.begin());
+  }
+};
+
+/// Builds the index from for_each_run(i, f) (f called with each run of
+/// observation i's region, ascending) without sorting the pieces: they are
+/// counted per segment, and each observation's written into its segments.
+template <typename ForEachRun>
+SharedSegments indexSegments(int n, ForEachRun&& for_each_run, int threads, const InterruptFlag* interrupt) {
+  SharedSegments index;
   {
-    std::vector<std::vector<std::uint64_t>> tiles_of(n);
+    std::vector<std::vector<std::uint64_t>> segments_of(n);
     parallelFor(n, threads, 64, [&](std::size_t i) {
-      auto& touched = tiles_of[i];
-      for_each_key(int(i), [&](std::uint64_t key) {
-        const std::uint64_t tile = tiles.tileOf(key);
-        if (touched.empty() || touched.back() != tile) touched.push_back(tile);
+      auto& mine = segments_of[i];
+      for_each_run(int(i), [&](std::uint64_t start, std::size_t length) {
+        forEachPiece(start, length, [&](std::uint64_t segment, std::uint8_t, std::uint8_t) {
+          if (mine.empty() || mine.back() != segment) mine.push_back(segment);
+        });
       });
-      std::sort(touched.begin(), touched.end());
-      touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     });
-    for (auto& touched : tiles_of) {
-      for (std::uint64_t tile : touched) tiles.add(tile);
-      std::vector<std::uint64_t>().swap(touched);
+    std::size_t total = 0;
+    for (const auto& mine : segments_of) total += mine.size();
+    index.segments.reserve(total);
+    for (auto& mine : segments_of) {
+      index.segments.insert(index.segments.end(), mine.begin(), mine.end());
+      std::vector<std::uint64_t>().swap(mine);
     }
   }
+  std::sort(index.segments.begin(), index.segments.end());
+  index.segments.erase(std::unique(index.segments.begin(), index.segments.end()), index.segments.end());
+  index.segments.shrink_to_fit();
   throwIfInterrupted(interrupt);
-  SlotCounters watchers_of_slot(tiles.slots());
-  const auto with_lookup = [&tiles] { return CellTiles::Lookup(tiles); };
-  parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
-    for_each_key(int(i), [&](std::uint64_t key) { watchers_of_slot.increment(lookup.existingSlot(key)); });
-  });
-  throwIfInterrupted(interrupt);
-  // Cells numbered in slot order; each slot's counter then counts the
-  // watchers written so far.
-  constexpr std::uint32_t kNoCell = ~std::uint32_t(0);
-  shared.cell_of_slot.assign(tiles.slots(), kNoCell);
-  std::size_t total = 0;
-  for (std::size_t slot = 0; slot < tiles.slots(); ++slot) {
-    const std::uint32_t watchers = watchers_of_slot.get(slot);
-    if (watchers == 0) continue;
-    if (shared.cell_start.size() >= kNoCell) throw std::length_error("region overlap: more than 2^32 - 1 cells");
-    shared.cell_of_slot[slot] = std::uint32_t(shared.cell_start.size());
-    shared.cell_start.push_back(total);
-    total += watchers;
-    watchers_of_slot.set(slot, 0);
-  }
-  shared.cell_start.push_back(total);
-  shared.watchers.resize(total);
-  parallelForWithScratch(n, threads, countingChunk(n, threads), with_lookup, [&](std::size_t i, CellTiles::Lookup& lookup) {
-    for_each_key(int(i), [&](std::uint64_t key) {
-      const std::size_t slot = lookup.existingSlot(key);
-      shared.watchers[shared.cell_start[shared.cell_of_slot[slot]] + watchers_of_slot.increment(slot)] =
-          std::uint32_t(i);
+  SlotCounters pieces_of(index.segments.size());
+  parallelFor(n, threads, countingChunk(n, threads), [&](std::size_t i) {
+    for_each_run(int(i), [&](std::uint64_t start, std::size_t length) {
+      forEachPiece(start, length, [&](std::uint64_t segment, std::uint8_t, std::uint8_t) {
+        pieces_of.increment(index.indexOf(segment));
+      });
     });
   });
   throwIfInterrupted(interrupt);
-  return shared;
+  index.start.resize(index.segments.size() + 1);
+  index.start[0] = 0;
+  for (std::size_t s = 0; s < index.segments.size(); ++s) {
+    index.start[s + 1] = index.start[s] + pieces_of.get(s);
+    pieces_of.set(s, 0);
+  }
+  index.pieces.resize(index.start.back());
+  parallelFor(n, threads, countingChunk(n, threads), [&](std::size_t i) {
+    for_each_run(int(i), [&](std::uint64_t start, std::size_t length) {
+      forEachPiece(start, length, [&](std::uint64_t segment, std::uint8_t first, std::uint8_t last) {
+        const std::size_t s = index.indexOf(segment);
+        index.pieces[index.start[s] + pieces_of.increment(s)] = {std::uint32_t(i), first, last};
+      });
+    });
+  });
+  throwIfInterrupted(interrupt);
+  return index;
 }
 
 /// For each observation, the other observations holding its cells and how
-/// many: integer counts, the same whatever the order of a cell's watchers.
-/// release(i) is called once observation i's keys are no longer needed, so
+/// many: the overlaps of its runs' pieces with theirs, integer sums, the same
+/// whatever the order of a segment's pieces. point_tests counts, as for
+/// points, each cell of i once per observation holding it (i included).
+/// release(i) is called once observation i's runs are no longer needed, so
 /// that lists can be freed as the rows are counted.
-template <typename ForEachKey, typename Release>
-MatchCounts countShared(int n, bool planar, ForEachKey&& for_each_key, Release&& release, int threads,
+template <typename ForEachRun, typename Release>
+MatchCounts countShared(int n, ForEachRun&& for_each_run, Release&& release, int threads,
                         const InterruptFlag* interrupt) {
-  const SharedCells cells = indexSharedCells(n, planar, for_each_key, threads, interrupt);
+  if (std::uint64_t(n) > std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error("region overlap: more than 2^32 - 1 observations");
+  const SharedSegments index = indexSegments(n, for_each_run, threads, interrupt);
   MatchCounts out;
   out.rows.resize(n);
   std::uint64_t pairs = 0, tests = 0;
@@ -375,18 +399,23 @@ MatchCounts countShared(int n, bool planar, ForEachKey&& for_each_key, Release&&
   {
     std::vector<std::uint32_t> shared(n, 0);
     std::vector<int> touched;
-    CellTiles::Lookup lookup(cells.tiles);
 #pragma omp for schedule(dynamic, 16)
     for (int i = 0; i < n; ++i) {
       if (interruptRequested(interrupt)) continue;
-      for_each_key(i, [&](std::uint64_t key) {
-        // The slot exists: indexSharedCells added it for this very key.
-        const std::uint32_t c = cells.cell_of_slot[lookup.slot(key)];
-        for (std::size_t w = cells.cell_start[c]; w < cells.cell_start[c + 1]; ++w) {
-          const std::uint32_t j = cells.watchers[w];
-          if (shared[j]++ == 0) touched.push_back(int(j));
-        }
-        tests += cells.cell_start[c + 1] - cells.cell_start[c];
+      for_each_run(i, [&](std::uint64_t start, std::size_t length) {
+        forEachPiece(start, length, [&](std::uint64_t segment, std::uint8_t first, std::uint8_t last) {
+          // The segment exists: indexSegments added it for this very piece.
+          const std::size_t s = index.indexOf(segment);
+          for (std::size_t k = index.start[s]; k < index.start[s + 1]; ++k) {
+            const SegmentPiece& other = index.pieces[k];
+            const int lo = std::max(first, other.first), hi = std::min(last, other.last);
+            if (hi < lo) continue;
+            const std::uint32_t cells = std::uint32_t(hi - lo + 1);
+            tests += cells;
+            if (shared[other.observation] == 0) touched.push_back(int(other.observation));
+            shared[other.observation] += cells;
+          }
+        });
       });
       release(i);
       std::sort(touched.begin(), touched.end());
@@ -410,8 +439,7 @@ MatchCounts countShared(RegionLists& lists, int threads, const InterruptFlag* in
   std::size_t bytes = 0;
   for (const auto& list : lists.cells) bytes += list.bytes();
   MatchCounts counts = countShared(
-      int(lists.cells.size()), lists.planar,
-      [&lists](int i, auto&& f) { lists.cells[std::size_t(i)].forEachCell(f); },
+      int(lists.cells.size()), [&lists](int i, auto&& f) { lists.cells[std::size_t(i)].forEachRun(f); },
       [&lists](int i) { lists.cells[std::size_t(i)] = RunList(); }, threads, interrupt);
   returnFreedMemory(bytes);
   return counts;
@@ -467,21 +495,25 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
   RegionLists lists = regionLists(model, world, sensor_origins, params, threadCount(threads), interrupt);
   std::vector<std::size_t> sizes(lists.cells.size());
   for (std::size_t i = 0; i < sizes.size(); ++i) sizes[i] = lists.cells[i].cells;
-  return assembleOverlap(countShared(lists, threadCount(threads), interrupt), sizes);
+  OverlapResult result = assembleOverlap(countShared(lists, threadCount(threads), interrupt), sizes);
+  returnFreedMemory(kTrimBytes);  // the rows of counts, a small list per observation
+  return result;
 }
 
 
 MatchCounts countSharedCells(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
   // ObservationRegions::append refused keys out of order: each region's are ascending and distinct.
   return countShared(
-      regions.size(), regions.planar, [&regions](int i, auto&& f) { regions.forEachCell(i, f); }, [](int) {},
-      threadCount(threads), interrupt);
+      regions.size(), [&regions](int i, auto&& f) { regions.forEachRun(i, f); }, [](int) {}, threadCount(threads),
+      interrupt);
 }
 
 OverlapResult regionOverlap(const ObservationRegions& regions, int threads, const InterruptFlag* interrupt) {
   std::vector<std::size_t> sizes(regions.size());
   for (int i = 0; i < regions.size(); ++i) sizes[i] = regions.count(i);
-  return assembleOverlap(countSharedCells(regions, threads, interrupt), sizes);
+  OverlapResult result = assembleOverlap(countSharedCells(regions, threads, interrupt), sizes);
+  returnFreedMemory(kTrimBytes);  // the rows of counts, a small list per observation
+  return result;
 }
 
 }  // namespace obsgroup
