@@ -20,13 +20,15 @@ struct GroupingOutcome {
   Partition partition;
   /// The place id of each group of `partition` (places.json, partition.json's place_ids).
   std::vector<int> place_ids;
+  /// The stream's W (the batch's stays in `grouping`: weights() gives either).
   WeightMatrix W;
   /// Points of each observation after filtering, as the overlap counts them.
   std::vector<std::size_t> points_per_observation;
   /// The observations' points in the common frame for the places and the
-  /// pictures: the batch's own (setKeepWorldPoints), or the stream's
-  /// (SensedSpaceOverlap::toWorld).
-  WorldPoints stream_world;
+  /// pictures (SensedSpaceOverlap::toWorld): the stream's, made after its
+  /// last update; the batch's, made again for the places (the grouping does
+  /// not keep its own through the partition: they are as large as the clouds).
+  WorldPoints world_points;
   bool online = false;
   /// pairs_evaluated, point_tests, edges, and what else the mode measures.
   nlohmann::json statistics = nlohmann::json::object();
@@ -35,7 +37,8 @@ struct GroupingOutcome {
   /// What partition.json records of the mode besides the method's parameters.
   nlohmann::json parameters = nlohmann::json::object();
 
-  const WorldPoints& world() const { return online ? stream_world : grouping.getWorldPoints(); }
+  const WorldPoints& world() const { return world_points; }
+  const WeightMatrix& weights() const { return online ? W : grouping.getWeightMatrix(); }
 };
 
 }  // namespace obsgroup::cli

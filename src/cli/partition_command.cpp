@@ -159,8 +159,7 @@ template <typename PointT>
 void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& grouping) {
   grouping.setInterruptFlag(args.interrupt);
   grouping.setParameters(args.method);
-  grouping.setKeepWorldPoints(true);  // the places and map.png are drawn from them
-  grouping.setKeepRegions(true);      // and cut from these
+  grouping.setKeepRegions(true);      // the places are cut from these
   grouping.setKeepOverlapMatrix(false);  // W is all the rest needs
 }
 
@@ -181,14 +180,13 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
   }
   bar.finish();
   for (std::size_t g = 0; g < out.partition.groups.size(); ++g) out.place_ids.push_back(int(g));
-  out.W = grouping.getWeightMatrix();
   const auto& overlap = grouping.getOverlap();
   out.points_per_observation = overlap.points_per_observation;
   // The back-ends count ordered pairs (i, j) and (j, i) alike (each row is
   // matched on its own); a user counts a pair once.
   out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated / 2},
                     {"point_tests", overlap.point_tests},
-                    {"edges", edgeCount(out.W)}};
+                    {"edges", edgeCount(out.weights())}};
   const auto& t = grouping.getTimings();
   out.timing_s = {{"overlap", t.overlap_s}, {"graph", t.graph_s}, {"partition", t.partition_s}};
 }
@@ -270,7 +268,7 @@ void drawPictures(const PartitionArgs& args, const io::OutputFolder& out, const 
                            globalPoses(maps.topology, observations.size()), partition, maps.topology,
                            tinted ? &regions : nullptr, places, slice);
   bar(1, 4);
-  render::writeWeightsPicture(staged, grouped.W, partition);
+  render::writeWeightsPicture(staged, grouped.weights(), partition);
   bar(2, 4);
   render::writeFiedlerPicture(staged, partition);
   bar(3, 4);
@@ -345,19 +343,25 @@ void writePlaces(const io::OutputFolder& out, const PlaceMap& places, Warnings& 
 }
 
 template <typename PointT>
-OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, const GroupingOutcome<PointT>& grouped,
-                         const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps,
+OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out, GroupingOutcome<PointT>& grouped,
+                         const std::vector<Observation<PointT>>& observations, MapsOfRun<PointT>& maps,
                          const Partition& of_every_frame, Warnings& warn) {
   const auto start = Clock::now();
   OutputTimes t;
   t.map_points = io::writeLocalMaps(out, maps.maps, args.method.threads);
   io::writeLabelledMap(out, maps.maps, grouped.place_ids);
+  if (!args.pictures) {  // written: only the local maps' pictures would read their points again
+    for (auto& map : maps.maps) map.cloud = std::make_shared<pcl::PointCloud<PointT>>();
+    returnFreedMemory(kTrimBytes);
+  }
   out.writeText("topology.json", io::topologyJson(maps.topology));
   out.writeText("topology.dot", io::topologyDot(maps.topology));
   out.writeText("local_maps/poses.txt", io::localMapPosesTum(maps.topology));
   const auto places_start = Clock::now();
   ProgressBar bar("places", !args.quiet, args.progress);
   bar(0, 2);
+  if (grouped.world_points.size() != int(observations.size()))
+    grouped.world_points = grouped.grouping.getSensedSpaceOverlap().toWorld(observations);
   // The grouping's own regions when it kept them (partition); computed here otherwise (stream, points model).
   const ObservationRegions& kept = grouped.grouping.getRegions();
   ObservationRegions computed;
@@ -375,6 +379,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
     // The groups and local maps stand without them.
     warn(std::string("places not written: ") + e.what());
   }
+  returnFreedMemory(kTrimBytes);
   if (places) {
     PlaceMap written = *places;  // with keyframes, each place's members are all the frames of its keyframes
     for (Place& place : written.places)
@@ -390,6 +395,8 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
     drawPictures(args, out, grouped, observations, maps, regions, places ? &*places : nullptr);
     t.pictures_s = secondsSince(pictures_start);
   }
+  grouped.world_points = WorldPoints{};  // nothing after needs them
+  returnFreedMemory(kTrimBytes);
   t.outputs_s = secondsSince(start);
   return t;
 }
@@ -675,7 +682,9 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   else
     groupObservations(args, observations, input, grouped);
   warnAboutGrouping(observations, input, grouped, warn);
-  const MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.W, warn);
+  returnFreedMemory(kTrimBytes);  // the partition's matrices, many below malloc's own threshold for returning them
+  MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.weights(), warn);
+  returnFreedMemory(kTrimBytes);
   io::OutputFolder out(args.output, args.force, args.interrupt);
   const Partition of_every_frame =
       keyframe_of.empty() ? grouped.partition : expandKeyframePartition(grouped.partition, keyframe_of);

@@ -36,8 +36,8 @@ inline std::string describeChange(const GroupChange& change) {
 /// (the places and the pictures draw on them).
 template <typename PointT>
 void addWorldPoints(const std::vector<Observation<PointT>>& observations, GroupingOutcome<PointT>& out) {
-  out.stream_world = out.grouping.getSensedSpaceOverlap().toWorld(observations);
-  for (int i = 0; i < out.stream_world.size(); ++i) out.points_per_observation.push_back(out.stream_world.count(i));
+  out.world_points = out.grouping.getSensedSpaceOverlap().toWorld(observations);
+  for (int i = 0; i < out.world_points.size(); ++i) out.points_per_observation.push_back(out.world_points.count(i));
 }
 
 /// Edges of W: the pairs i < j that overlap (the batch's OverlapResult::pairs).

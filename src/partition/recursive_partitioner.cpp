@@ -203,7 +203,12 @@ class Partitioner {
     const std::vector<int>& members = current.members;
     d.child_depth = current.depth;
     if (members.size() < 2) return d;  // Leaf / TooFewNodes by default
-    const WeightMatrix sub = inducedSubgraph(W_, members, local_of);
+    // The root's block is W itself (its members are every node, ascending):
+    // no copy of the largest matrix of the run.
+    WeightMatrix copied;
+    const bool whole = Eigen::Index(members.size()) == W_.rows();
+    if (!whole) copied = inducedSubgraph(W_, members, local_of);
+    const WeightMatrix& sub = whole ? W_ : copied;
     if (splitIntoComponents(sub, members, d)) return d;
     const int min_size = std::max(1, options_.min_group_size);
     if (static_cast<int>(members.size()) < 2 * min_size) return d;  // TooFewNodes
@@ -305,25 +310,33 @@ class Partitioner {
   Partition out_;
 };
 
+/// W(col, row) when W holds it, else nullptr: a binary search of column
+/// `row`, whose row indices Eigen keeps ascending.
+const double* mirrorEntry(const WeightMatrix& W, Eigen::Index row, Eigen::Index col) {
+  const int* inner = W.innerIndexPtr();
+  const Eigen::Index begin = W.outerIndexPtr()[row];
+  const Eigen::Index end = W.isCompressed() ? W.outerIndexPtr()[row + 1] : begin + W.innerNonZeroPtr()[row];
+  const int* found = std::lower_bound(inner + begin, inner + end, int(col));
+  return found != inner + end && *found == col ? W.valuePtr() + (found - inner) : nullptr;
+}
+
 /// Weights are overlaps: finite, non-negative and symmetric. Anything else
 /// would make Ncut meaningless, so it is refused rather than partitioned.
+/// Each entry's mirror is looked up in place: a transposed copy of W would
+/// be the largest allocation of a large run's partition.
 void checkWeights(const WeightMatrix& W) {
-  const WeightMatrix T = W.transpose();  // O(nnz); compared in lock step with W
-  for (Eigen::Index c = 0; c < W.outerSize(); ++c) {
-    WeightMatrix::InnerIterator it(W, c), mirror(T, c);
-    for (; it; ++it, ++mirror) {
+  for (Eigen::Index c = 0; c < W.outerSize(); ++c)
+    for (WeightMatrix::InnerIterator it(W, c); it; ++it) {
       const double w = it.value();
       if (!std::isfinite(w) || w < 0.0)
         throw std::invalid_argument("recursivePartition: W(" + std::to_string(it.row()) + ", " +
                                     std::to_string(it.col()) + ") = " + std::to_string(w) +
                                     " is not a finite, non-negative weight");
-      if (!mirror || mirror.row() != it.row() || std::abs(w - mirror.value()) > 1e-9 * std::max(1.0, w))
+      const double* mirror = mirrorEntry(W, it.row(), c);
+      if (!mirror || std::abs(w - *mirror) > 1e-9 * std::max(1.0, w))
         throw std::invalid_argument("recursivePartition: W is not symmetric near (" +
                                     std::to_string(it.row()) + ", " + std::to_string(it.col()) + ")");
     }
-    if (mirror)
-      throw std::invalid_argument("recursivePartition: W is not symmetric in column " + std::to_string(c));
-  }
 }
 
 /// PartitionOptions::boundary_passes: each observation joins the group with

@@ -178,7 +178,10 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCell
                               const std::vector<std::vector<int>>& groups, const std::vector<Occupancy>& occupancy) {
   const std::size_t cells = occupancy.size();
   std::vector<int> owner(cells, kNone);
-  std::vector<std::uint32_t> best_count(cells, 0), count(cells, 0), seen_by(cells, 0);
+  std::vector<std::uint32_t> best_count(cells, 0), count(cells, 0);
+  // Plane cells of one region are distinct; voxels stacked above a cell are not.
+  const bool stacked = !regions.planar;
+  std::vector<std::uint32_t> seen_by(stacked ? cells : 0, 0);
   std::vector<std::uint32_t> touched;
   std::uint32_t stamp = 0;  // which observation last counted a cell (its position + 1)
   for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -187,8 +190,10 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCell
       ++stamp;
       regions.forEachCell(i, [&](std::uint64_t key) {
         const std::size_t c = cell_of(key);
-        if (seen_by[c] == stamp) return;  // another voxel of this observation above the cell
-        seen_by[c] = stamp;
+        if (stacked) {
+          if (seen_by[c] == stamp) return;  // another voxel of this observation above the cell
+          seen_by[c] = stamp;
+        }
         if (count[c]++ == 0) touched.push_back(std::uint32_t(c));
       });
     }

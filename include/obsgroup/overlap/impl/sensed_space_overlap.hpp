@@ -2,7 +2,6 @@
 
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/overlap/shared_grid_matcher.h"
-#include "obsgroup/common/freed_memory.h"
 #include "obsgroup/common/parallel_for.h"
 
 #include "obsgroup/cloud/finite_points.h"
@@ -72,20 +71,31 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
   if (n > 0 && observations[0].pose.translation().allFinite())
     world.origin = observations[0].pose.translation();
 
-  std::vector<std::vector<Eigen::Vector3f>> per_observation(n);
+  // Block by block, so that the points are never held twice (every
+  // observation's own list, then the whole). Without a voxel filter only
+  // non-finite points drop out: the clouds' sizes bound the total, reserved
+  // at once (pages never written are never resident), so the list does not
+  // move as it grows.
+  if (voxel_leaf_ == 0.0) {
+    std::size_t bound = 0;
+    for (const auto& o : observations) bound += o.cloud ? o.cloud->size() : 0;
+    world.points.reserve(bound);
+  }
   const int threads = threadCount(threads_);
-  parallelFor(n, threads, 4, [&](std::size_t i) {
-    try {
-      per_observation[i] = observationToWorld(observations[i], world.origin);
-    } catch (const std::exception& e) {
-      throw InvalidObservation(static_cast<int>(i), e.what());
-    }
-  });
-  world.appendAll(per_observation, threads);
-  std::size_t bytes = 0;
-  for (const auto& points : per_observation) bytes += points.capacity() * sizeof(Eigen::Vector3f);
-  per_observation = {};
-  returnFreedMemory(bytes);  // the copies, now in `world`, would stay resident
+  constexpr int kBlock = 4096;
+  std::vector<std::vector<Eigen::Vector3f>> block;
+  for (int first = 0; first < n; first += kBlock) {
+    block.assign(std::size_t(std::min(kBlock, n - first)), {});
+    parallelFor(block.size(), threads, 4, [&](std::size_t k) {
+      const int i = first + int(k);
+      try {
+        block[k] = observationToWorld(observations[i], world.origin);
+      } catch (const std::exception& e) {
+        throw InvalidObservation(i, e.what());
+      }
+    });
+    world.appendAll(block, threads);
+  }
   return world;
 }
 
