@@ -331,12 +331,12 @@ class OpeningWidths {
       for (int y = 0; y < ny_; ++y) blocked_[index(x, y)] = blocked(Cell<2>{lo[0] + x, lo[1] + y});
     // Free cells from the run's start (forward) and to its end (backward),
     // kOpen when the run reaches the box's edge on that side.
-    forward_.assign(cells * kAxes, 0);
-    backward_.assign(cells * kAxes, 0);
-    for (int x = 0; x < nx_; ++x)
-      for (int y = 0; y < ny_; ++y) sweep(forward_, x, y, -1);
-    for (int x = nx_ - 1; x >= 0; --x)
-      for (int y = ny_ - 1; y >= 0; --y) sweep(backward_, x, y, +1);
+    for (int k = 0; k < kAxes; ++k) {
+      forward_[k].resize(cells);
+      backward_[k].resize(cells);
+      sweep(k, forward_[k], -1);
+      sweep(k, backward_[k], +1);
+    }
   }
 
   /// The free run through cell c along axis k, in cells (c included), or
@@ -344,9 +344,10 @@ class OpeningWidths {
   std::uint32_t run(const Cell<2>& c, int k) const {
     const int x = int(c[0] - lo_[0]), y = int(c[1] - lo_[1]);
     if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return kOpen;
-    const std::size_t i = index(x, y) * kAxes + std::size_t(k);
-    if (forward_[i] == kOpen || backward_[i] == kOpen) return kOpen;
-    return std::uint32_t(forward_[i]) + backward_[i] - 1;
+    const std::size_t i = index(x, y);
+    const std::uint8_t ahead = forward_[k][i], behind = backward_[k][i];
+    if (ahead == kOpen || behind == kOpen) return kOpen;
+    return std::uint32_t(ahead) + behind - 1;
   }
 
   /// The step of axis k, in cells.
@@ -357,29 +358,51 @@ class OpeningWidths {
 
  private:
   std::size_t index(int x, int y) const { return std::size_t(x) * std::size_t(ny_) + std::size_t(y); }
-  // One cell of a pass; `sign` -1 looks back along each axis, +1 ahead, at a
-  // neighbour the pass has already visited.
-  void sweep(std::vector<std::uint8_t>& runs, int x, int y, int sign) {
-    const std::size_t i = index(x, y);
-    if (blocked_[i]) return;  // 0: not free
-    for (int k = 0; k < kAxes; ++k) {
-      const auto a = axis(k);
-      const int px = x + sign * a[0], py = y + sign * a[1];
-      std::uint8_t& r = runs[i * kAxes + std::size_t(k)];
-      if (px < 0 || py < 0 || px >= nx_ || py >= ny_) {
-        r = kOpen;
+  /// One pass along axis k: each free cell counts one more than its
+  /// neighbour behind it (sign -1: back along the axis; +1: ahead), kOpen
+  /// past the box's edge; a blocked cell is 0. The count saturates at kOpen:
+  /// runs of kOpen - 1 cells and more are wider than any door.
+  void sweep(int k, std::vector<std::uint8_t>& runs, int sign) {
+    const auto a = axis(k);
+    const int dx = sign * a[0], dy = sign * a[1];
+    const auto step = [](std::uint8_t before) { return std::uint8_t(before + (before != kOpen)); };
+    if (dx == 0) {
+      // Along a column: rows in the order the neighbour is visited first,
+      // every column at once (independent, where one column's rows are not).
+      for (int yi = 0; yi < ny_; ++yi) {
+        const int y = dy > 0 ? ny_ - 1 - yi : yi;
+        const bool open = y + dy < 0 || y + dy >= ny_;
+        for (int x = 0; x < nx_; ++x) {
+          const std::size_t i = index(x, y);
+          runs[i] = blocked_[i] ? 0 : (open ? kOpen : step(runs[index(x, y + dy)]));
+        }
+      }
+      return;
+    }
+    // Columns (x) in the order the neighbour is visited first.
+    for (int xi = 0; xi < nx_; ++xi) {
+      const int x = dx > 0 ? nx_ - 1 - xi : xi;
+      const int px = x + dx;
+      const bool column_open = px < 0 || px >= nx_;
+      const char* blocked = blocked_.data() + index(x, 0);
+      std::uint8_t* out = runs.data() + index(x, 0);
+      // The neighbour lies in the previous column, done: rows in any order.
+      if (column_open) {
+        for (int y = 0; y < ny_; ++y) out[y] = blocked[y] ? 0 : kOpen;
         continue;
       }
-      // Runs longer than kOpen - 1 cells are wider than any door: open.
-      const std::uint8_t before = runs[index(px, py) * kAxes + std::size_t(k)];
-      r = before >= kOpen - 1 ? kOpen : std::uint8_t(before + 1);
+      const std::uint8_t* before = runs.data() + index(px, 0);
+      const int y_lo = std::max(0, -dy), y_hi = std::min(ny_, ny_ - dy);  // rows whose neighbour is in the box
+      for (int y = 0; y < y_lo; ++y) out[y] = blocked[y] ? 0 : kOpen;
+      for (int y = y_lo; y < y_hi; ++y) out[y] = blocked[y] ? 0 : step(before[y + dy]);
+      for (int y = std::max(y_lo, y_hi); y < ny_; ++y) out[y] = blocked[y] ? 0 : kOpen;
     }
   }
 
   Cell<2> lo_{};
   int nx_ = 0, ny_ = 0;
   std::vector<char> blocked_;
-  std::vector<std::uint8_t> forward_, backward_;
+  std::array<std::vector<std::uint8_t>, kAxes> forward_, backward_;
 };
 
 /// The opening widths of one view, and scratch for its rays: by its own
@@ -388,6 +411,9 @@ class OpeningWidths {
 struct ViewWidths {
   OpeningWidths own, shared;
   std::vector<int> to_wide;  ///< per ray: narrow cells before its first wide one (-1: none)
+  /// Per ray, its unit direction (cos, sin of its angle), for `rays` rays.
+  std::vector<std::array<double, 2>> directions;
+  int rays = 0;
 };
 
 /// Follows one ray of the visibility model through free cells and says when
@@ -399,9 +425,10 @@ struct ViewWidths {
 /// (startInDoorway).
 class DoorCrossing {
  public:
-  DoorCrossing(const RegionParameters& params, double cell_size, double angle)
+  /// For a ray of unit direction (cos, sin of its angle).
+  DoorCrossing(const RegionParameters& params, double cell_size, const std::array<double, 2>& direction)
       : width_(params.door_width / cell_size), depth_(params.door_depth / cell_size) {
-    const double dx = std::cos(angle), dy = std::sin(angle);
+    const double dx = direction[0], dy = direction[1];
     for (int k = 0; k < OpeningWidths::kAxes; ++k) {
       const auto a = OpeningWidths::axis(k);
       const double length = std::hypot(double(a[0]), double(a[1]));
@@ -476,14 +503,27 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     }
   const bool doors = params.door_width > 0;
   if (doors) {
-    widths.shared.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c) || occupancy.occupied(c); });
-    widths.own.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c); });
+    // Each table only when a ray reads it: a 360-degree scan covers every
+    // ray, and never needs the shared one.
+    const bool any_own = std::find(covered.begin(), covered.end(), 1) != covered.end();
+    const bool any_shared = std::find(covered.begin(), covered.end(), 0) != covered.end();
+    if (any_shared)
+      widths.shared.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c) || occupancy.occupied(c); });
+    if (any_own) widths.own.compute(lo, hi, [&](const Cell<2>& c) { return own.marked(c); });
   }
   // Walks ray r through the cells it sees, calling free_cell(cell) on each
   // free one (false stops it) and seen(cell) on every cell.
+  if (widths.rays != rays) {  // the same for every view of a run: computed once per thread
+    widths.directions.resize(rays);
+    for (int r = 0; r < rays; ++r) {
+      const double angle = kTwoPi * r / rays;
+      widths.directions[r] = {std::cos(angle), std::sin(angle)};
+    }
+    widths.rays = rays;
+  }
+  const auto& directions = widths.directions;
   const auto walk = [&](int r, auto&& free_cell, auto&& seen) {
-    const double angle = kTwoPi * r / rays;
-    const std::array<double, 2> end{o[0] + range * std::cos(angle), o[1] + range * std::sin(angle)};
+    const std::array<double, 2> end{o[0] + range * directions[r][0], o[1] + range * directions[r][1]};
     // Where the observation looked, its own beams say what it saw: only its
     // own surfaces stop the ray, so drifted copies of other observations'
     // walls do not cut its view. Elsewhere (behind a forward laser, beside
@@ -502,7 +542,6 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
       return !crossed_free && t < clear;
     });
   };
-  const auto angleOf = [&](int r) { return kTwoPi * r / rays; };
   // A pose in a doorway (its rays start narrow) stands on the side whose
   // wide space is nearer: each ray's narrow cells before its first wide one,
   // -1 when it never reaches wide space.
@@ -510,7 +549,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
   if (doors) {
     to_wide.assign(rays, -1);
     for (int r = 0; r < rays; ++r) {
-      const DoorCrossing probe(params, grid.size, angleOf(r));
+      const DoorCrossing probe(params, grid.size, directions[r]);
       int narrow = 0;
       walk(
           r,
@@ -530,7 +569,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // A ray that comes through a door stops in the first wide cell beyond
     // it: the view is of the place the observation stands in. From a
     // doorway, the far side is beyond the door.
-    DoorCrossing door(params, grid.size, angleOf(r));
+    DoorCrossing door(params, grid.size, directions[r]);
     if (doors) {
       const int opposite = to_wide[(r + rays / 2) % rays];
       // More than one cell nearer: a pose in the middle of the doorway sees both sides.
