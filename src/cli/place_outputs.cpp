@@ -183,6 +183,9 @@ bool readGreyPng(std::FILE* file, GreyImage& image, png_byte* pixels, std::size_
     return false;
   }
   png_init_io(png, file);
+  // The label map of a long route is wider than libpng's default limit of a
+  // million pixels; readPlaceLabels bounds the pixels instead.
+  png_set_user_limits(png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
   png_read_info(png, info);
   image.width = png_get_image_width(png, info);
   image.height = png_get_image_height(png, info);

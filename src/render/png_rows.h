@@ -37,6 +37,9 @@ inline bool writePngRows(std::FILE* file, int width, int height, int bit_depth, 
     return false;
   }
   png_init_io(png, file);
+  // A label map one cell a pixel of a long route is wider than libpng's
+  // default limit of a million pixels; the format's own is 2^31 - 1.
+  png_set_user_limits(png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
   const int colour = pixels == PngPixels::Grey ? PNG_COLOR_TYPE_GRAY
                      : pixels == PngPixels::Rgba ? PNG_COLOR_TYPE_RGB_ALPHA
                                                  : PNG_COLOR_TYPE_RGB;
@@ -183,6 +186,7 @@ inline bool writePalettePng(std::FILE* file, int width, int height, const Indexe
     return false;
   }
   png_init_io(png, file);
+  png_set_user_limits(png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);  // as writePngRows
   png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_PALETTE, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_set_PLTE(png, info, pixels.palette.data(), int(pixels.palette.size()));
