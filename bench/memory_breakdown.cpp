@@ -1,6 +1,6 @@
 // Where the bytes of a grouping go: reads an input as `obsgroup partition`
-// does (the same options), groups it as the command does (world points and
-// regions kept for the places), and prints the size of each structure per
+// does (the same options), groups it keeping its world points and regions
+// (the command keeps the regions and makes the points again), and prints the size of each structure per
 // observation, then the process's peak resident memory.
 //   memory_breakdown INPUT [partition options...]
 // docs/performance.md ("Memory") is made from its output.
@@ -11,6 +11,8 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <type_traits>
@@ -51,12 +53,21 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
   const obsgroup::WorldPoints& world = grouping.getWorldPoints();
   rows.push_back({"world points (12 B a point)", capacityBytes(world.points) + capacityBytes(world.offsets) +
                                                      capacityBytes(world.boxes),
-                  "overlap, places, pictures"});
+                  "overlap; made again for the places and pictures"});
   const obsgroup::ObservationRegions& regions = grouping.getRegions();
   rows.push_back({"regions (10 B a run of cells)", double(regions.bytes()), "overlap, places"});
-  // countSharedCells' index: a watcher per region cell (its start per distinct cell and its tile
-  // slots, a few per cent more, are left out).
-  rows.push_back({"shared-cell index (4 B a cell of a region)", 4.0 * double(regions.totalCells()), "overlap"});
+  // countSharedCells' index: a piece per run and 64-key segment it crosses (8 bytes), and each
+  // segment's key and start (16 bytes).
+  std::size_t pieces = 0;
+  std::vector<std::uint64_t> segments;
+  for (int i = 0; i < regions.size(); ++i)
+    regions.forEachRun(i, [&](std::uint64_t start, std::size_t length) {
+      for (std::uint64_t s = start >> 6; s <= (start + length - 1) >> 6; ++s, ++pieces) segments.push_back(s);
+    });
+  std::sort(segments.begin(), segments.end());
+  const double distinct = double(std::unique(segments.begin(), segments.end()) - segments.begin());
+  rows.push_back({"shared-segment index (8 B a run piece, 16 B a segment)", 8.0 * double(pieces) + 16.0 * distinct,
+                  "overlap"});
   const obsgroup::OverlapResult& overlap = grouping.getOverlap();
   rows.push_back({"Pi and the pairs of Psi", double(overlap.match_ratio.nonZeros()) * (sizeof(double) + sizeof(int)) +
                                                  capacityBytes(overlap.pairs),
