@@ -4,23 +4,32 @@
 # `obsgroup partition --no-pictures` with the default settings on 10,010 and
 # 100,100 scans: wall time, peak resident memory and the stages' timing_s
 # (medians of REPEATS runs). Targets of the scale work: 100,000 scans in at
-# most 20 s and 1.6 GiB.
+# most 20 s and 1.6 GiB; 1,000,000 in at most 10 minutes and 16 GiB.
 #
-#   bench/memory.sh [--output docs/performance.md] [REPEATS=3]
+#   bench/memory.sh [--output docs/performance.md] [--million] [REPEATS=3]
+#
+# --million adds one run of 1,001,000 scans (a 2.3 GB log made once in the
+# work folder; about 6 minutes and 16 GiB on 2 cores).
 #
 # With --output the tables replace the lines between "<!-- memory:begin -->"
 # and "<!-- memory:end -->" of that file.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-output=""
-if [ "${1:-}" = --output ]; then output=$2; shift 2; fi
+output="" sizes="10010 100100"
+while [ $# -gt 0 ]; do
+  case $1 in
+    --output) output=$2; shift 2 ;;
+    --million) sizes="$sizes 1001000"; shift ;;
+    *) break ;;
+  esac
+done
 repeats=${1:-3}
 work=${OBSGROUP_BENCH_DIR:-${TMPDIR:-/tmp}/obsgroup-bench}
 mkdir -p "$work"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DOBSGROUP_BUILD_BENCHMARKS=ON > /dev/null
 cmake --build build -j"$(nproc)" --target obsgroup_cli make_scaling_input memory_breakdown > /dev/null
 cp build/obsgroup "$work/obsgroup-memory"  # a rebuild during the run cannot mix two versions
-for n in 10010 100100; do
+for n in $sizes; do
   [ -f "$work/building_$n.clf" ] || build/bench/make_scaling_input 2d "$n" "$work/building_$n.clf" > /dev/null
 done
 table=$(mktemp)
@@ -32,18 +41,18 @@ echo
 build/bench/memory_breakdown "$work/building_100100.clf" |
   sed -e 's/^observations\(.*\)/Observations\1.\n/' -e 's/^peak resident memory\(.*\)/\nPeak resident memory of memory_breakdown\1./'
 echo
-python3 - "$work" "$repeats" <<'PY'
+python3 - "$work" "$repeats" $sizes <<'PY'
 import json, os, statistics, subprocess, sys, time
-work, repeats = sys.argv[1], int(sys.argv[2])
+work, repeats, sizes = sys.argv[1], int(sys.argv[2]), [int(n) for n in sys.argv[3:]]
 exe = os.path.join(work, "obsgroup-memory")
 stages = ["load", "overlap", "graph", "partition", "local_maps", "places", "outputs"]
-print(f"`obsgroup partition --no-pictures`, default settings, the run of median wall time of {repeats} (peak RSS: the largest of the runs; `outputs` includes `places`):")
+print(f"`obsgroup partition --no-pictures`, default settings, the run of median wall time of {repeats} (a million scans: one run; peak RSS: the largest of the runs; `outputs` includes `places`):")
 print()
 print("| scans | wall s | peak RSS MiB, max | " + " | ".join(f"{s} s" for s in stages) + " | groups |")
 print("|---" * (len(stages) + 4) + "|")
-for n in (10010, 100100):
+for n in sizes:
     runs = []
-    for _ in range(repeats):
+    for _ in range(repeats if n < 1000000 else 1):
         out = os.path.join(work, f"memory_out_{n}")
         subprocess.run(["rm", "-rf", out], check=True)
         start = time.perf_counter()
