@@ -159,7 +159,7 @@ template <typename PointT>
 void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& grouping) {
   grouping.setInterruptFlag(args.interrupt);
   grouping.setParameters(args.method);
-  grouping.setKeepRegions(true);      // the places are cut from these
+  grouping.setKeepRegions(true);         // the places are cut from these
   grouping.setKeepOverlapMatrix(false);  // W is all the rest needs
 }
 

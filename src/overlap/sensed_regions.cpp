@@ -282,7 +282,8 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
         else
           freeSpaceOf<2>(pointsOf(world, static_cast<int>(i)), sensor_origins[i], params, cells, s.marker2, s.keys);
         // The markers give each key once, ascending.
-        per_observation[i].assign(s.keys.data(), s.keys.data() + s.keys.size());
+        if (!per_observation[i].assign(s.keys.data(), s.keys.data() + s.keys.size()))
+          throw std::logic_error("computeRegions: a region's cells came out of order");
       });
   throwIfInterrupted(interrupt);
   regions.planar = !volumetric;
