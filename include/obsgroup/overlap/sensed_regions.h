@@ -104,8 +104,8 @@ inline bool operator!=(const RegionParameters& a, const RegionParameters& b) { r
 
 /// The cells of every observation's region. A region is kept as runs of
 /// consecutive keys (a column of plane cells, a stack of voxels): a 6 m
-/// visibility region of 0.2 m cells is about 1,000 cells in 60 to 100 runs,
-/// so 10 bytes a run instead of 8 a cell (docs/performance.md).
+/// visibility region of 0.2 m cells is about 950 cells in about 60 runs,
+/// 10 bytes a run where a list of keys takes 8 a cell (docs/performance.md).
 class ObservationRegions {
  public:
   bool planar = true;  ///< 2D cells (x, y) or 3D voxels
@@ -129,7 +129,7 @@ class ObservationRegions {
   /// Cells of all regions (a cell in two regions counts twice).
   std::size_t totalCells() const { return cell_offsets_.back(); }
   bool empty() const { return cell_offsets_.back() == 0; }
-  /// Runs of all regions, and the bytes they and their offsets take.
+  /// Runs of all regions; the bytes they and their offsets take.
   std::size_t runCount() const { return run_start_.size(); }
   std::size_t bytes() const;
 
