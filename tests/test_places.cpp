@@ -10,9 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <set>
+#include <stdexcept>
 
 namespace obsgroup {
 namespace {
@@ -188,6 +191,69 @@ TEST(Places, LocateReturnsTheOwnPlaceOfMostObservations) {
   EXPECT_TRUE(g.places.locate(Eigen::Vector2d(1e4, 1e4), 1e12).place);
   EXPECT_FALSE(g.places.locate(Eigen::Vector2d(1e30, -1e30), 1.0).place);
   EXPECT_FALSE(g.places.locate(Eigen::Vector2d(NAN, 0)).place);
+}
+
+/// The same places whether the points are held (WorldPoints) or asked for
+/// one observation at a time (PlacePointSource), in 2D and in 3D (points
+/// above the obstacle band too); a source that throws is rethrown.
+TEST(Places, PointsAskedForOneObservationAtATimeGiveTheSamePlaces) {
+  const sim::Building office = sim::makeBuilding("office");
+  std::vector<sim::Pose2D> route;
+  for (std::size_t k = 0; k < office.route.size(); k += 3) route.push_back(office.route[k]);
+  for (const bool three_d : {false, true}) {
+    const auto observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
+                                      : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    grouping.setKeepRegions(true);
+    for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+    const Partition partition = grouping.compute();
+    const auto& sso = grouping.getSensedSpaceOverlap();
+    const WorldPoints world = sso.toWorld(observations);
+    const Eigen::Vector3d origin = SensedSpaceOverlap<pcl::PointXYZ>::worldOrigin(observations);
+    ASSERT_EQ(origin, world.origin);
+    std::vector<Eigen::Vector3d> sensors;
+    for (const auto& o : observations) sensors.push_back(o.pose.translation() - origin);
+    std::vector<int> ids(partition.groups.size());
+    std::iota(ids.begin(), ids.end(), 7);
+    const PlaceMap held = buildPlaceMap(grouping.getRegions(), world, sensors, partition.groups, ids);
+    std::atomic<int> asked{0};
+    const PlacePointSource on_demand = [&](int i, std::vector<Eigen::Vector3f>& scratch) {
+      ++asked;
+      scratch = sso.observationToWorld(observations[std::size_t(i)], origin);
+      return std::make_pair(scratch.data(), scratch.data() + scratch.size());
+    };
+    const PlaceMap made = buildPlaceMap(grouping.getRegions(), origin, on_demand, sensors, partition.groups, ids);
+    EXPECT_EQ(asked.load(), int(observations.size()));  // once each
+    ASSERT_GT(held.places.size(), 1u);
+    EXPECT_EQ(made.labels, held.labels) << "3D: " << three_d;
+    EXPECT_EQ(made.occupancy, held.occupancy) << "3D: " << three_d;
+    ASSERT_EQ(made.places.size(), held.places.size());
+    for (std::size_t k = 0; k < held.places.size(); ++k) {
+      EXPECT_EQ(made.places[k].outline, held.places[k].outline);
+      EXPECT_EQ(made.places[k].neighbours, held.places[k].neighbours);
+    }
+    ASSERT_EQ(made.doors.size(), held.doors.size());
+    for (std::size_t k = 0; k < held.doors.size(); ++k) EXPECT_EQ(made.doors[k].midpoint, held.doors[k].midpoint);
+    EXPECT_GT(std::count(held.occupancy.begin(), held.occupancy.end(), Occupancy::Occupied), 0);
+  }
+  const sim::Building office_again = sim::makeBuilding("office");
+  const auto observations = test::simulate<pcl::PointXYZ>(office_again.plan, route, sim::laser360());
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  grouping.setKeepRegions(true);
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  const Partition partition = grouping.compute();
+  std::vector<Eigen::Vector3d> sensors;
+  for (const auto& o : observations) sensors.push_back(o.pose.translation() - observations[0].pose.translation());
+  const PlacePointSource failing = [](int i, std::vector<Eigen::Vector3f>&)
+      -> std::pair<const Eigen::Vector3f*, const Eigen::Vector3f*> {
+    if (i == 5) throw std::runtime_error("scan 5 cannot be read");
+    return {nullptr, nullptr};
+  };
+  std::vector<int> ids(partition.groups.size(), 0);
+  std::iota(ids.begin(), ids.end(), 0);
+  EXPECT_THROW(buildPlaceMap(grouping.getRegions(), observations[0].pose.translation(), failing, sensors,
+                             partition.groups, ids),
+               std::runtime_error);
 }
 
 TEST(Places, BadArgumentsAreRefused) {

@@ -1,6 +1,7 @@
 #include "obsgroup/places/place_map.h"
 
 #include "obsgroup/common/parallel_for.h"
+#include "../overlap/region_cells.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -9,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <list>
 #include <map>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -56,16 +59,10 @@ struct GridFrame {
   }
 };
 
-bool isObstacle(const Eigen::Vector3f& p, const Eigen::Vector3d& sensor, bool planar, const PlaceOptions& options) {
-  if (planar) return true;
-  const double height = double(p.z()) - sensor.z();
-  return height >= options.band_low && height <= options.band_high;
-}
-
 /// The grid over the regions' cells and a border of one cell: the floor
 /// lies in the regions, and an obstacle beyond them (a far return) says
 /// nothing of any place.
-GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) {
+GridFrame makeGrid(const ObservationRegions& regions, const Eigen::Vector3d& world_origin) {
   const double cs = regions.cell_size;
   GridFrame f;
   f.grid.resolution = cs;
@@ -85,21 +82,30 @@ GridFrame makeGrid(const ObservationRegions& regions, const WorldPoints& world) 
   f.first = lo - Eigen::Vector2i::Ones();
   f.grid.width = int(size.x());
   f.grid.height = int(size.y());
-  f.grid.origin = Eigen::Vector2d(world.origin.x(), world.origin.y()) + f.base + cs * f.first.cast<double>();
+  f.grid.origin = Eigen::Vector2d(world_origin.x(), world_origin.y()) + f.base + cs * f.first.cast<double>();
   return f;
 }
 
-/// Marks in `crossed` the cells a beam of observation i crosses on its way
+/// What the beams say of a cell, as bits: one crossed it, a point lies in
+/// it, a point within the obstacle band lies in it.
+enum CellSeen : std::uint8_t { kCrossed = 1, kPoint = 2, kPointInBand = 4 };
+
+/// Marks in `seen` the cells a beam of an observation crosses on its way
 /// from the sensor to a point (seen from above; the point's own cell
-/// excluded), by a grid traversal (Amanatides & Woo).
-void markRays(const GridFrame& f, const WorldPoints& world, const Eigen::Vector3d& sensor, int i,
-              std::vector<char>& crossed) {
+/// excluded), by a grid traversal (Amanatides & Woo), and the cells its
+/// points lie in.
+void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::Vector3d& sensor,
+               const PlaceOptions& options, std::vector<std::uint8_t>& seen) {
   const FloorGrid& g = f.grid;
   // Positions in cells of the grid, as GridFrame::cellX/cellY put them.
   const Eigen::Vector2d corner = f.base + g.resolution * f.first.cast<double>();
   const double sx = (sensor.x() - corner.x()) / g.resolution;
   const double sy = (sensor.y() - corner.y()) / g.resolution;
-  for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p) {
+  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p) {
+    if (const auto k = f.indexOf(p->x(), p->y())) {
+      const double height = double(p->z()) - sensor.z();
+      seen[*k] |= std::uint8_t(kPoint | (height >= options.band_low && height <= options.band_high ? kPointInBand : 0));
+    }
     const double ex = (double(p->x()) - corner.x()) / g.resolution;
     const double ey = (double(p->y()) - corner.y()) / g.resolution;
     int x = int(std::floor(sx)), y = int(std::floor(sy));
@@ -113,7 +119,7 @@ void markRays(const GridFrame& f, const WorldPoints& world, const Eigen::Vector3
     // Beyond the grid a ray marks nothing: stop where it leaves for good.
     const int steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
     for (int k = 0; k < steps; ++k) {
-      if (g.contains(x, y)) crossed[g.index(x, y)] = 1;
+      if (g.contains(x, y)) seen[g.index(x, y)] |= kCrossed;
       if (next_x < next_y) {
         next_x += delta_x;
         x += step_x;
@@ -125,25 +131,45 @@ void markRays(const GridFrame& f, const WorldPoints& world, const Eigen::Vector3
   }
 }
 
-/// The cells some beam crossed: every observation's every ray, traversed on every thread, each into its own
-/// grid, OR-ed together (the same cells for any thread count). A grid too
-/// large to copy per thread is traversed on one.
-std::vector<char> crossedCells(const GridFrame& f, const WorldPoints& world, const std::vector<Eigen::Vector3d>& sensors) {
+/// What every observation's beams say of each cell (CellSeen bits), in one
+/// pass over the observations, each asked for its points once: every
+/// thread marks its own grid, OR-ed together (the same cells for any thread
+/// count). A grid too large to copy per thread is marked on one. `planar`
+/// is whether the sensors and points all lie at the first sensor's height
+/// (isPlanarData). Rethrows what points_of throws.
+std::vector<std::uint8_t> seenCells(const GridFrame& f, const PlacePointSource& points_of,
+                                    const std::vector<Eigen::Vector3d>& sensors, double cell_size,
+                                    const PlaceOptions& options, bool& planar) {
   const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
-  const int n = world.size();
+  const int n = int(sensors.size());
   constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
   const int threads = std::max(1, std::min({omp_get_max_threads(), n, int(kMaxCopiedBytes / std::max<std::size_t>(cells, 1))}));
-  std::vector<std::vector<char>> crossed(static_cast<std::size_t>(threads));
-#pragma omp parallel num_threads(threads)
-  {
-    std::vector<char>& mine = crossed[std::size_t(omp_get_thread_num())];
-    mine.assign(cells, 0);
-#pragma omp for schedule(dynamic, 16)
-    for (int i = 0; i < n; ++i) markRays(f, world, sensors[std::size_t(i)], i, mine);
-  }
-  for (std::size_t t = 1; t < crossed.size(); ++t)
-    for (std::size_t k = 0; k < cells; ++k) crossed[0][k] |= crossed[t][k];
-  return std::move(crossed[0]);
+  std::list<std::vector<std::uint8_t>> seen;  // one per thread; a list, so that each stays where it was made
+  std::mutex seen_mutex;
+  struct Scratch {
+    std::vector<std::uint8_t>* seen;
+    std::vector<Eigen::Vector3f> points;
+  };
+  std::vector<char> flat(std::size_t(n), 1);
+  const double z0 = n > 0 ? sensors[0].z() : 0.0;
+  parallelForWithScratch(
+      std::size_t(n), threads, 16,
+      [&] {
+        std::lock_guard<std::mutex> lock(seen_mutex);
+        seen.emplace_back(cells, std::uint8_t(0));
+        return Scratch{&seen.back(), {}};
+      },
+      [&](std::size_t i, Scratch& s) {
+        const auto [begin, end] = points_of(int(i), s.points);
+        const region_cells::PointSpan span{begin, end};
+        flat[i] = region_cells::observationPlanar(span, sensors[i], z0, 0.25 * cell_size);
+        markBeams(f, span, sensors[i], options, *s.seen);
+      });
+  planar = std::all_of(flat.begin(), flat.end(), [](char c) { return c != 0; });
+  if (seen.empty()) return std::vector<std::uint8_t>(cells, 0);
+  for (auto other = std::next(seen.begin()); other != seen.end(); ++other)
+    for (std::size_t k = 0; k < cells; ++k) seen.front()[k] |= (*other)[k];
+  return std::move(seen.front());
 }
 
 /// The grid cell of a region cell's key (3D voxels fall on the cell below
@@ -611,11 +637,23 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
                        const std::vector<Eigen::Vector3d>& sensor_origins,
                        const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
                        const PlaceOptions& options) {
+  if (world.size() != regions.size())
+    throw std::invalid_argument("buildPlaceMap: regions and points of " + std::to_string(regions.size()) + " and " +
+                                std::to_string(world.size()) + " observations");
+  const PlacePointSource points_of = [&world](int i, std::vector<Eigen::Vector3f>&) {
+    return std::make_pair(world.begin(i), world.end(i));
+  };
+  return buildPlaceMap(regions, world.origin, points_of, sensor_origins, groups, place_ids, options);
+}
+
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
+                       const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options) {
   const int n = regions.size();
-  if (world.size() != n || int(sensor_origins.size()) != n)
-    throw std::invalid_argument("buildPlaceMap: regions, points and sensor origins of " + std::to_string(n) + ", " +
-                                std::to_string(world.size()) + " and " + std::to_string(sensor_origins.size()) +
-                                " observations");
+  if (int(sensor_origins.size()) != n)
+    throw std::invalid_argument("buildPlaceMap: regions and sensor origins of " + std::to_string(n) + " and " +
+                                std::to_string(sensor_origins.size()) + " observations");
   if (place_ids.size() != groups.size())
     throw std::invalid_argument("buildPlaceMap: one place id per group expected");
   std::vector<int> group_of(n, kNone);
@@ -635,24 +673,24 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
       !(std::isfinite(options.band_low) && std::isfinite(options.band_high) && options.band_low < options.band_high))
     throw std::invalid_argument("buildPlaceMap: the door width and piece area must be finite and >= 0, the band "
                                 "finite with low < high");
-  const bool planar = isPlanarData(world, sensor_origins, regions.cell_size);
-  const GridFrame f = makeGrid(regions, world);
+  const GridFrame f = makeGrid(regions, world_origin);
   const FloorGrid& g = f.grid;
   map.grid = g;
   const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
+  bool planar = true;
+  const std::vector<std::uint8_t> seen = seenCells(f, points_of, sensor_origins, regions.cell_size, options, planar);
   // Floor is what a beam crossed and a region holds: a region model may
   // reach where no beam went (visibility all around a forward sensor).
-  const std::vector<char> crossed = crossedCells(f, world, sensor_origins);
   const FloorCellOfKey cell_of(regions, f);
   map.occupancy.assign(cells, Occupancy::Unknown);
   for (int i = 0; i < n; ++i)
     regions.forEachCell(i, [&](std::uint64_t key) {
-      if (const std::size_t k = cell_of(key); crossed[k]) map.occupancy[k] = Occupancy::Free;
+      if (const std::size_t k = cell_of(key); seen[k] & kCrossed) map.occupancy[k] = Occupancy::Free;
     });
-  for (int i = 0; i < n; ++i)
-    for (const Eigen::Vector3f* p = world.begin(i); p != world.end(i); ++p)
-      if (isObstacle(*p, sensor_origins[i], planar, options))
-        if (const auto k = f.indexOf(p->x(), p->y())) map.occupancy[*k] = Occupancy::Occupied;
+  // Planar data is all obstacle; in 3D, the points within the band above the floor.
+  const std::uint8_t obstacle = planar ? kPoint : kPointInBand;
+  for (std::size_t k = 0; k < cells; ++k)
+    if (seen[k] & obstacle) map.occupancy[k] = Occupancy::Occupied;
 
   std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, cell_of, groups, map.occupancy)) : std::vector<int>{};
   const double cell_area = g.resolution * g.resolution;

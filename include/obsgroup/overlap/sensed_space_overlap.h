@@ -81,8 +81,15 @@ class SensedSpaceOverlap {
   /// std::invalid_argument on a null cloud, a non-finite pose or a voxel
   /// leaf too small for a cloud's extent.
   WorldPoints toWorld(const std::vector<Observation<PointT>>& observations) const;
+  /// The origin toWorld re-centres the points on: the first observation's
+  /// position (zero when there is none or it is not finite).
+  static Eigen::Vector3d worldOrigin(const std::vector<Observation<PointT>>& observations) {
+    if (!observations.empty() && observations[0].pose.translation().allFinite())
+      return observations[0].pose.translation();
+    return Eigen::Vector3d::Zero();
+  }
   /// One observation's points as toWorld gives them, re-centred on `origin`
-  /// (toWorld's: the first observation's position). Throws
+  /// (worldOrigin, as toWorld does). Throws
   /// std::invalid_argument as toWorld does.
   std::vector<Eigen::Vector3f> observationToWorld(const Observation<PointT>& observation,
                                                   const Eigen::Vector3d& origin) const;

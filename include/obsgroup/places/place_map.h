@@ -13,7 +13,9 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace obsgroup {
@@ -127,6 +129,23 @@ double twiceSignedArea(const std::vector<Eigen::Vector2d>& ring);
 /// not match, options out of range, or a grid of more than 400 million cells.
 PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& world,
                        const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options = {});
+
+/// Observation i's points as WorldPoints holds them (re-centred on the
+/// world origin, as the regions are), asked for once per observation, from
+/// several threads at once, each with its own `scratch`: a source that makes
+/// the points on demand fills `scratch` and returns its range; one that holds
+/// them returns theirs.
+using PlacePointSource = std::function<std::pair<const Eigen::Vector3f*, const Eigen::Vector3f*>(
+    int i, std::vector<Eigen::Vector3f>& scratch)>;
+
+/// buildPlaceMap with the points asked for one observation at a time, so
+/// that a large run need not hold every observation's world points at once
+/// (100,100 scans: about 430 MiB); `world_origin` is WorldPoints::origin.
+/// The same places as from the WorldPoints holding the same points.
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
+                       const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
                        const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
                        const PlaceOptions& options = {});
 

@@ -68,8 +68,7 @@ WorldPoints SensedSpaceOverlap<PointT>::toWorld(const std::vector<Observation<Po
     throw std::invalid_argument("voxel leaf size must be finite and >= 0");
   const int n = static_cast<int>(observations.size());
   WorldPoints world;
-  if (n > 0 && observations[0].pose.translation().allFinite())
-    world.origin = observations[0].pose.translation();
+  world.origin = worldOrigin(observations);
 
   // Block by block, so that the points are never held twice (every
   // observation's own list, then the whole). Without a voxel filter only
