@@ -53,7 +53,7 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
   const obsgroup::WorldPoints& world = grouping.getWorldPoints();
   rows.push_back({"world points (12 B a point)", capacityBytes(world.points) + capacityBytes(world.offsets) +
                                                      capacityBytes(world.boxes),
-                  "overlap; made again for the places and pictures"});
+                  "overlap; made again for the pictures (the places make each observation's in turn)"});
   const obsgroup::ObservationRegions& regions = grouping.getRegions();
   rows.push_back({"regions (10 B a run of cells)", double(regions.bytes()), "overlap, places"});
   // countSharedCells' index: a piece per run and 64-key segment it crosses (8 bytes), and each
@@ -71,7 +71,7 @@ std::vector<Row> breakdown(const obsgroup::cli::PartitionArgs& args,
   const obsgroup::OverlapResult& overlap = grouping.getOverlap();
   rows.push_back({"Pi and the pairs of Psi", double(overlap.match_ratio.nonZeros()) * (sizeof(double) + sizeof(int)) +
                                                  capacityBytes(overlap.pairs),
-                  "from the overlap on"});
+                  "overlap, until W stands"});
   rows.push_back({"W", sparseBytes(grouping.getWeightMatrix()), "from the graph on"});
   double partition_bytes = capacityBytes(partition.group_of);
   for (const auto& g : partition.groups) partition_bytes += capacityBytes(g);
