@@ -6,7 +6,9 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
 
 #include <omp.h>
 
@@ -476,22 +478,39 @@ struct MarkSizes {
   double label_radius = 11, dot_radius = 5, arc_width = 3, arrow = 10, arrow_width = 1.5;
 };
 
+/// Each centre's distance to the nearest other one, by a kd-tree: a million
+/// scans make 50,000 groups, and all pairs would be 2.5 billion distances.
+std::vector<double> nearestOtherDistances(const std::vector<Eigen::Vector2d>& centres) {
+  if (centres.size() < 2) return {};
+  const pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& c : centres) cloud->push_back(pcl::PointXYZ(float(c.x()), float(c.y()), 0.0f));
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  std::vector<double> nearest(centres.size());
+  std::vector<int> index;
+  std::vector<float> squared;
+  for (std::size_t a = 0; a < centres.size(); ++a) {
+    // Two neighbours: the first may be the centre itself or another at the same place.
+    tree.nearestKSearch(int(a), 2, index, squared);
+    double d = 1e300;
+    for (int b : index)
+      if (b != int(a)) d = std::min(d, (centres[a] - centres[std::size_t(b)]).norm());
+    nearest[a] = d;
+  }
+  return nearest;
+}
+
 MarkSizes markSizes(const MapLayout& layout, std::size_t observations) {
   const auto& c = layout.centres;
-  std::vector<double> nearest;
-  for (std::size_t a = 0; a < c.size(); ++a) {
-    double d = 1e300;
-    for (std::size_t b = 0; b < c.size(); ++b)
-      if (b != a) d = std::min(d, (c[a] - c[b]).norm());
-    if (c.size() > 1) nearest.push_back(d);
-  }
+  std::vector<double> nearest = nearestOtherDistances(c);
   double spacing = 60;
   if (!nearest.empty()) {
     std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
     spacing = nearest[nearest.size() / 2];
   }
   MarkSizes s;
-  if (c.size() > 1000) s.label_radius = 13;  // room for four digits
+  if (c.size() > 10000) s.label_radius = 16;  // room for five digits
+  else if (c.size() > 1000) s.label_radius = 13;  // four
   s.dot_radius = std::clamp(0.3 * spacing, 2.5, 5.0);
   s.arc_width = std::clamp(0.15 * spacing, 1.2, 3.5);
   s.arrow = std::clamp(0.5 * layout.view.scale, 6.0, 12.0);
@@ -560,7 +579,7 @@ void groupMark(cairo_t* cr, double x, double y, int group, const Rgb& c, bool la
     return;
   }
   const std::string number = std::to_string(group);
-  const double size = number.size() > 3 ? 10 : (number.size() > 2 ? 11 : 13);
+  const double size = number.size() > 4 ? 9.5 : number.size() > 3 ? 10 : (number.size() > 2 ? 11 : 13);
   cairo_arc(cr, x, y, sizes.label_radius, 0, 2 * M_PI);
   cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
   cairo_fill_preserve(cr);
