@@ -40,6 +40,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <unordered_map>
 
 namespace obsgroup::cli {
 
@@ -403,9 +404,11 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   returnFreedMemory(kTrimBytes);
   if (places) {
     PlaceMap written = *places;  // with keyframes, each place's members are all the frames of its keyframes
+    std::unordered_map<int, std::size_t> group_of_place;  // a million scans make 50,000 places: no scan of all per place
+    for (std::size_t g = 0; g < grouped.place_ids.size(); ++g) group_of_place.emplace(grouped.place_ids[g], g);
     for (Place& place : written.places)
-      for (std::size_t g = 0; g < grouped.place_ids.size(); ++g)
-        if (grouped.place_ids[g] == place.id) place.members = of_every_frame.groups[g];
+      if (const auto g = group_of_place.find(place.id); g != group_of_place.end())
+        place.members = of_every_frame.groups[g->second];
     writePlaces(out, written, warn);
   }
   bar(2, 2);

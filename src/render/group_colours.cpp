@@ -1,6 +1,11 @@
 #include "group_colours.h"
 
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <tuple>
 #include <utility>
@@ -8,6 +13,46 @@
 namespace obsgroup::render {
 
 namespace {
+
+/// A kd-tree over the group centres, re-centred on the first so that float
+/// coordinates keep millimetres even at map coordinates like UTM's.
+struct CentreTree {
+  explicit CentreTree(const std::vector<Eigen::Vector3d>& centres) : cloud(new pcl::PointCloud<pcl::PointXYZ>) {
+    if (centres.empty()) return;
+    for (const auto& c : centres) {
+      const Eigen::Vector3d p = c - centres[0];
+      cloud->push_back(pcl::PointXYZ(float(p.x()), float(p.y()), float(p.z())));
+      extent = std::max(extent, p.cwiseAbs().maxCoeff());
+    }
+    tree.setInputCloud(cloud);
+  }
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  double extent = 0.0;
+};
+
+/// The (up to) two centres nearest centre g, other than g, exactly as sorting
+/// every other by (squared distance in double, index) would give them: the
+/// kd-tree's three nearest bound the distance, and every centre within it
+/// (plus the float coordinates' rounding) is ranked in double. A million
+/// scans make 50,000 groups: all pairs would be 2.5 billion distances.
+std::vector<int> twoNearestOthers(const std::vector<Eigen::Vector3d>& centre, int g, const CentreTree& t) {
+  if (centre.size() < 2) return {};
+  std::vector<int> index;
+  std::vector<float> squared;
+  t.tree.nearestKSearch(g, 3, index, squared);
+  const double bound = std::sqrt(double(*std::max_element(squared.begin(), squared.end())));
+  const double radius = bound * (1 + 1e-5) + 1e-5 * (1 + t.extent);
+  t.tree.radiusSearch(g, radius, index, squared);
+  std::vector<std::pair<double, int>> by_distance;
+  for (int h : index)
+    if (h != g) by_distance.emplace_back((centre[std::size_t(g)] - centre[std::size_t(h)]).squaredNorm(), h);
+  const std::size_t k = std::min<std::size_t>(2, by_distance.size());
+  std::partial_sort(by_distance.begin(), by_distance.begin() + k, by_distance.end());
+  std::vector<int> nearest;
+  for (std::size_t j = 0; j < k; ++j) nearest.push_back(by_distance[j].second);
+  return nearest;
+}
 
 /// Neighbours of each node, ascending: joined by one of `arcs` (indices into
 /// topology.arcs), or among each other's two nearest centres (the mean of
@@ -25,15 +70,10 @@ std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology, co
     for (const auto& member : node.member_poses) centre[g] += (node.pose * member).translation();
     centre[g] /= double(std::max<std::size_t>(1, node.member_poses.size()));
   }
-  for (int g = 0; g < n; ++g) {
-    std::vector<std::pair<double, int>> by_distance;
-    for (int h = 0; h < n; ++h)
-      if (h != g) by_distance.emplace_back((centre[g] - centre[h]).squaredNorm(), h);
-    const std::size_t k = std::min<std::size_t>(2, by_distance.size());
-    std::partial_sort(by_distance.begin(), by_distance.begin() + k, by_distance.end());
-    for (std::size_t j = 0; j < k; ++j)
-      neighbours[g].push_back(by_distance[j].second), neighbours[by_distance[j].second].push_back(g);
-  }
+  const CentreTree tree(centre);
+  for (int g = 0; g < n; ++g)
+    for (int h : twoNearestOthers(centre, g, tree))
+      neighbours[g].push_back(h), neighbours[h].push_back(g);
   for (auto& list : neighbours) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
