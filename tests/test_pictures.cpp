@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <memory>
 #include <random>
+#include <set>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -248,6 +249,35 @@ TEST(GroupColours, ADenseTopologyKeepsTheShownArcsApart) {
   for (std::size_t a : render::shownArcs(topology, 3))
     EXPECT_NE(colours[topology.arcs[a].from], colours[topology.arcs[a].to]);
   EXPECT_LT(*std::max_element(colours.begin(), colours.end()), 12);  // all well separated
+}
+
+/// The two nearest centres of every group, as comparing all pairs would
+/// give them, ties to the lower index: on a lattice (four neighbours at one
+/// distance, and stacked duplicates) far from the origin, as UTM maps are.
+TEST(GroupColours, NeighboursAreTheTwoNearestCentresWithTiesToTheLowerIndex) {
+  TopologicalMap topology;
+  for (int g = 0; g < 150; ++g) {
+    LocalMapFrame node;
+    node.pose.translation() << 500000.0 + 2.0 * (g % 10), 5400000.0 + 2.0 * ((g / 10) % 10), 0.0;  // rows 0-4 twice
+    node.member_poses.push_back(Eigen::Isometry3d::Identity());
+    topology.nodes.push_back(node);
+  }
+  const auto neighbours = render::groupNeighbours(topology, {});
+  ASSERT_EQ(neighbours.size(), topology.nodes.size());
+  std::vector<std::set<int>> expected(topology.nodes.size());
+  for (int g = 0; g < 150; ++g) {
+    std::vector<std::pair<double, int>> by_distance;
+    for (int h = 0; h < 150; ++h)
+      if (h != g)
+        by_distance.emplace_back((topology.nodes[g].pose.translation() - topology.nodes[h].pose.translation()).squaredNorm(), h);
+    std::sort(by_distance.begin(), by_distance.end());
+    for (int j = 0; j < 2; ++j) expected[g].insert(by_distance[j].second), expected[by_distance[j].second].insert(g);
+  }
+  for (int g = 0; g < 150; ++g)
+    EXPECT_EQ(std::set<int>(neighbours[g].begin(), neighbours[g].end()), expected[g]) << "group " << g;
+  const std::vector<int> colours = render::groupColours(topology);
+  for (int g = 0; g < 150; ++g)
+    for (int h : expected[g]) EXPECT_NE(colours[g], colours[h]);
 }
 
 TEST(ShownArcs, EachNodeKeepsItsStrongest) {

@@ -21,6 +21,12 @@ inline constexpr int kDistinctColours = 12;
 /// (shownArcs(), 3 per group) and the nearest centres count.
 std::vector<int> groupColours(const TopologicalMap& topology);
 
+/// Neighbours of each node, ascending: joined by one of `arcs` (indices into
+/// topology.arcs), or among each other's two nearest centres (the mean of
+/// the members' global poses; ties: the lower index), the pairs groupColours
+/// keeps apart.
+std::vector<std::vector<int>> groupNeighbours(const TopologicalMap& topology, const std::vector<std::size_t>& arcs);
+
 /// The arcs map.png draws, indices into topology.arcs, ascending: each node's
 /// `per_node` strongest (by weight, then overlapping and sequence pairs).
 /// topology.json keeps all of them.
