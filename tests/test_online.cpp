@@ -202,6 +202,29 @@ TEST(OnlineGrouping, ReportsChangesAndKeepsIdsOfUntouchedGroups) {
   EXPECT_EQ(online.getGroups(), before);
 }
 
+TEST(OnlineGrouping, ViewsClosedByTheirOwnPointsAreNotRecomputedWhenOthersFlipCells) {
+  // Visibility: a 360-degree scan has a point of its own along every ray, so
+  // its view reads none of the shared occupancy and an insert that flips
+  // cells near it leaves it alone. A forward laser's views read the shared
+  // occupancy behind the robot: they are recomputed. Both stay equal to batch.
+  std::size_t recomputed[2] = {0, 0};
+  const sim::LaserModel lasers[2] = {sim::laser360(), sim::laser180()};
+  for (int l = 0; l < 2; ++l) {
+    auto obs = test::simulate<pcl::PointXYZ>(sim::office(), sim::officeRoute(60), lasers[l]);
+    std::vector<Eigen::Isometry3d> truth;
+    for (const auto& o : obs) truth.push_back(o.pose);
+    const auto drifted = sim::drift(truth, 7);
+    OnlineGrouping<pcl::PointXYZ> online;
+    for (std::size_t k = 0; k + 1 < obs.size(); ++k) online.insert(obs[k].cloud, drifted[k]);
+    online.update();
+    online.insert(obs.back().cloud, drifted.back());
+    recomputed[l] = online.update().observations_recomputed;
+    expectEqualsBatch(online, batchLike(SensedSpaceModel::Visibility), lasers[l].full_turn ? "360" : "180");
+  }
+  EXPECT_EQ(recomputed[0], 1u);  // the new scan alone
+  EXPECT_GT(recomputed[1], 1u);
+}
+
 TEST(OnlineGrouping, LoopClosureRepartitionsOnlyTheGroupsItTouches) {
   // A long building, points model: a row of W changes only for the moved
   // observations and the ones they overlap.

@@ -34,6 +34,7 @@ struct Slot {
   bool planar = true;       // within a quarter cell of z = 0 (the first observation's height)
   // As last computed (they may lag `points` until update()):
   std::vector<std::uint64_t> region, hit, crossed;
+  bool reads_occupancy = true;  // visibility: its region read the shared occupancy grid
   std::vector<PairCounts> row;  // ascending j
 };
 
@@ -257,14 +258,16 @@ struct IncrementalOverlap::State {
   }
 
   /// The present slots whose view (the box of cells within range of the
-  /// sensor, as visibilityOf casts it) holds a flipped cell.
+  /// sensor, as visibilityOf casts it) holds a flipped cell, among those
+  /// whose last view read the shared occupancy at all.
   std::vector<int> viewsReaching(const std::vector<std::uint64_t>& flipped) const {
     std::vector<int> out;
     if (flipped.empty()) return out;
     const double range = params.max_range / grid.size;
     for (int i = 0; i < int(slots.size()); ++i) {
       const Slot& s = slots[i];
-      if (!s.present || s.points.empty()) continue;
+      // A view that read none of the shared occupancy cannot change with it.
+      if (!s.present || s.points.empty() || !s.reads_occupancy) continue;
       const auto [lo, hi] = boxAround<2>(grid.inCells<2>(s.origin), range);
       const std::uint64_t first = keyOf<2>(lo), last = keyOf<2>(hi);
       // Keys ascend with x first: only flipped keys between the box's
@@ -286,8 +289,10 @@ struct IncrementalOverlap::State {
     s.region.clear();
     if (!s.present) return;
     const PointSpan points{s.points.data(), s.points.data() + s.points.size()};
-    if (model == SensedSpaceModel::Visibility)
+    if (model == SensedSpaceModel::Visibility) {
       visibilityOf(points, s.origin, params, grid, planar_used, reader, own, marker2, widths, s.region);
+      s.reads_occupancy = widths.read_occupancy;
+    }
     else if (!planar_used)
       freeSpaceOf<3>(points, s.origin, params, grid, marker3, s.region);
     else

@@ -414,6 +414,11 @@ struct ViewWidths {
   /// Per ray, its unit direction (cos, sin of its angle), for `rays` rays.
   std::vector<std::array<double, 2>> directions;
   int rays = 0;
+  /// Whether the last view read the shared occupancy: false when every ray
+  /// had a point of the observation's own that way, and the view then
+  /// depends on its own points alone (online grouping need not recompute it
+  /// when others flip cells).
+  bool read_occupancy = false;
 };
 
 /// Follows one ray of the visibility model through free cells and says when
@@ -480,6 +485,7 @@ class DoorCrossing {
 inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const RegionParameters& params,
                          const CellGrid& grid, bool planar, OccupancyGrid::Reader& occupancy, RegionMarker<2>& own,
                          RegionMarker<2>& marker, ViewWidths& widths, std::vector<std::uint64_t>& out) {
+  widths.read_occupancy = false;
   if (points.empty()) return;  // an observation with no point sensed nothing
   const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
   const auto o = grid.inCells<2>(origin);
@@ -501,6 +507,9 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
       if (angle < 0) angle += kTwoPi;
       covered[std::min(rays - 1, int(std::lround(angle / kTwoPi * rays)) % rays)] = 1;
     }
+  // An uncovered ray reads the shared occupancy: on its walk, and through
+  // the shared widths table when doors are on.
+  widths.read_occupancy = std::find(covered.begin(), covered.end(), 0) != covered.end();
   const bool doors = params.door_width > 0;
   if (doors) {
     // Each table only when a ray reads it: a 360-degree scan covers every

@@ -23,7 +23,9 @@ namespace obsgroup {
 ///  - free space: the same, through the cells its beams cross;
 ///  - visibility: also every observation whose view reaches a cell whose
 ///    occupancy the change flipped (the occupancy grid is made of everyone's
-///    points), however far from the changed one.
+///    points), however far from the changed one, unless that view read none
+///    of the shared occupancy (it had a point of its own along every ray, as
+///    a 360-degree scan in a closed room has: only its own surfaces stop it).
 /// Those regions are recomputed with the batch code, and the shared-cell
 /// counts patched by the difference of the old and new regions. The weights
 /// are then those SensedSpaceOverlap::compute gives for the observations
