@@ -1,5 +1,6 @@
 #include "local_maps.h"
 
+#include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <type_traits>
 
@@ -26,9 +28,23 @@ std::size_t writeLocalMaps(const OutputFolder& out, const std::vector<LocalMap<P
     // PCL writes VIEWPOINT with 6 significant digits; topology.json keeps the full pose.
     out.write(name, [&cloud](const std::string& temporary) {
       // PCL refuses to write an empty cloud in binary; an ASCII header with 0 points is valid.
-      const int status = cloud.empty() ? pcl::io::savePCDFileASCII(temporary, cloud)
-                                       : pcl::io::savePCDFileBinaryCompressed(temporary, cloud);
-      if (status < 0) throw std::runtime_error(temporary + ": cannot write");
+      if (cloud.empty()) {
+        if (pcl::io::savePCDFileASCII(temporary, cloud) < 0) throw std::runtime_error(temporary + ": cannot write");
+        return;
+      }
+      // The same bytes as savePCDFileBinaryCompressed, written through a
+      // stream: that one maps each file into memory under a file lock, and
+      // two threads writing thousands of small maps then wait on each other
+      // in the kernel (100,100 scans: 5,004 maps).
+      pcl::PCLPointCloud2 blob;
+      pcl::toPCLPointCloud2(cloud, blob);
+      std::ostringstream bytes;
+      if (pcl::PCDWriter().writeBinaryCompressed(bytes, blob, cloud.sensor_origin_, cloud.sensor_orientation_) < 0)
+        throw std::runtime_error(temporary + ": cannot write");
+      std::ofstream file(temporary, std::ios::binary);
+      file << bytes.str();
+      file.close();
+      if (!file) throw std::runtime_error(temporary + ": cannot write");
     });
   });
   std::size_t total = 0;
