@@ -426,21 +426,6 @@ class OpeningWidths {
   std::array<std::vector<std::uint8_t>, kAxes> forward_, backward_;
 };
 
-/// The opening widths of one view, and scratch for its rays: by its own
-/// surfaces (for the rays it saw along, as its own surfaces alone stop them)
-/// and by its own and the shared occupied cells (for the others).
-struct ViewWidths {
-  OpeningWidths own, shared;
-  std::vector<int> to_wide;  ///< per ray: narrow cells before its first wide one (-1: none)
-  /// Per ray, its unit direction (cos, sin of its angle), for `rays` rays.
-  std::vector<std::array<double, 2>> directions;
-  int rays = 0;
-  /// Whether the last view read the shared occupancy: false when every ray
-  /// had a point of the observation's own that way, and the view then
-  /// depends on its own points alone (online grouping need not recompute it
-  /// when others flip cells).
-  bool read_occupancy = false;
-};
 
 /// Follows one ray of the visibility model through free cells and says when
 /// it has come through a door: a stretch no longer than door_depth where the
@@ -500,6 +485,27 @@ class DoorCrossing {
   int narrow_cells_ = 0;
 };
 
+/// The opening widths of one view, and scratch for its rays: by its own
+/// surfaces (for the rays it saw along, as its own surfaces alone stop them)
+/// and by its own and the shared occupied cells (for the others).
+struct ViewWidths {
+  OpeningWidths own, shared;
+  std::vector<int> to_wide;  ///< per ray: narrow cells before its first wide one (-1: none)
+  /// Per ray, its unit direction (cos, sin of its angle), for `rays` rays.
+  std::vector<std::array<double, 2>> directions;
+  int rays = 0;
+  /// Per ray, its DoorCrossing before the walk, for `rays` rays and the
+  /// door width and depth and cell size of `doors_for`: the same for every
+  /// view of a run, made once per thread.
+  std::vector<DoorCrossing> doors;
+  std::array<double, 3> doors_for{};
+  /// Whether the last view read the shared occupancy: false when every ray
+  /// had a point of the observation's own that way, and the view then
+  /// depends on its own points alone (online grouping need not recompute it
+  /// when others flip cells).
+  bool read_occupancy = false;
+};
+
 /// The cells visible from observation i's position: rays all around it at a
 /// fixed set of world angles (so the heading plays no part), each stopped by
 /// the first occupied cell it enters beyond the clearance, that cell included.
@@ -550,6 +556,13 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
       widths.directions[r] = {std::cos(angle), std::sin(angle)};
     }
     widths.rays = rays;
+    widths.doors.clear();
+  }
+  const std::array<double, 3> doors_for{params.door_width, params.door_depth, grid.size};
+  if (doors && (widths.doors.size() != std::size_t(rays) || widths.doors_for != doors_for)) {
+    widths.doors.clear();
+    for (int r = 0; r < rays; ++r) widths.doors.emplace_back(params, grid.size, widths.directions[r]);
+    widths.doors_for = doors_for;
   }
   const auto& directions = widths.directions;
   const auto walk = [&](int r, auto&& free_cell, auto&& seen) {
@@ -579,7 +592,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
   if (doors) {
     to_wide.assign(rays, -1);
     for (int r = 0; r < rays; ++r) {
-      const DoorCrossing probe(params, grid.size, directions[r]);
+      const DoorCrossing& probe = widths.doors[r];
       int narrow = 0;
       walk(
           r,
@@ -599,7 +612,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // A ray that comes through a door stops in the first wide cell beyond
     // it: the view is of the place the observation stands in. From a
     // doorway, the far side is beyond the door.
-    DoorCrossing door(params, grid.size, directions[r]);
+    DoorCrossing door = doors ? widths.doors[r] : DoorCrossing(params, grid.size, directions[r]);
     if (doors) {
       const int opposite = to_wide[(r + rays / 2) % rays];
       // More than one cell nearer: a pose in the middle of the doorway sees both sides.
@@ -637,9 +650,14 @@ void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const Re
     std::array<double, 2> e = grid.inCells<2>(p->cast<double>());
     s.ends.push_back(cellOf<2>(e));
     // The beam counts as seeing through the cells it crosses within range.
-    const double length = std::hypot(e[0] - o[0], e[1] - o[1]);
-    if (length > range)
-      for (int a = 0; a < 2; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+    // Most points lie within range: std::hypot (slow, and the clipping's
+    // length as before) only where the squares leave a doubt.
+    const double dx = e[0] - o[0], dy = e[1] - o[1];
+    if (dx * dx + dy * dy > range * range * (1.0 - 1e-9)) {
+      const double length = std::hypot(dx, dy);
+      if (length > range)
+        for (int a = 0; a < 2; ++a) e[a] = o[a] + (e[a] - o[a]) * (range / length);
+    }
     s.targets.push_back(e);
     const Cell<2> t = cellOf<2>(e);
     for (int a = 0; a < 2; ++a)
