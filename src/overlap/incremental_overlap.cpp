@@ -292,11 +292,11 @@ struct IncrementalOverlap::State {
     if (model == SensedSpaceModel::Visibility) {
       visibilityOf(points, s.origin, params, grid, planar_used, reader, own, marker2, widths, s.region);
       s.reads_occupancy = widths.read_occupancy;
-    }
-    else if (!planar_used)
+    } else if (!planar_used) {
       freeSpaceOf<3>(points, s.origin, params, grid, marker3, s.region);
-    else
+    } else {
       freeSpaceOf<2>(points, s.origin, params, grid, marker2, s.region);
+    }
   }
 
   /// Changes of the cells slot i shares with each other slot, summed over

@@ -426,7 +426,6 @@ class OpeningWidths {
   std::array<std::vector<std::uint8_t>, kAxes> forward_, backward_;
 };
 
-
 /// Follows one ray of the visibility model through free cells and says when
 /// it has come through a door: a stretch no longer than door_depth where the
 /// free space across the ray is narrower than door_width, entered from and
@@ -556,10 +555,9 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
       widths.directions[r] = {std::cos(angle), std::sin(angle)};
     }
     widths.rays = rays;
-    widths.doors.clear();
   }
   const std::array<double, 3> doors_for{params.door_width, params.door_depth, grid.size};
-  if (doors && (widths.doors.size() != std::size_t(rays) || widths.doors_for != doors_for)) {
+  if (widths.doors.size() != std::size_t(rays) || widths.doors_for != doors_for) {
     widths.doors.clear();
     for (int r = 0; r < rays; ++r) widths.doors.emplace_back(params, grid.size, widths.directions[r]);
     widths.doors_for = doors_for;
@@ -612,7 +610,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // A ray that comes through a door stops in the first wide cell beyond
     // it: the view is of the place the observation stands in. From a
     // doorway, the far side is beyond the door.
-    DoorCrossing door = doors ? widths.doors[r] : DoorCrossing(params, grid.size, directions[r]);
+    DoorCrossing door = widths.doors[r];
     if (doors) {
       const int opposite = to_wide[(r + rays / 2) % rays];
       // More than one cell nearer: a pose in the middle of the doorway sees both sides.
