@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <random>
 #include <set>
@@ -346,6 +347,110 @@ TEST_F(Pictures, AThousandGroupsKeepTheirMarksApart) {
   const Png png(writeMap(scene));
   ASSERT_TRUE(png.ok());
   EXPECT_EQ(png.width(), layout.view.width);
+}
+
+TEST_F(Pictures, GroupsTooCloseForTheirMarksAreDrawnAsADensity) {
+  // 6,000 groups of two observations 0.5 m apart along a 3 km route: about a
+  // pixel apart on the canvas, each joined to the next.
+  Scene scene;
+  EXPECT_FALSE(scene.layout().coarse);  // four rooms: a mark each
+  scene.poses.clear();
+  scene.partition = Partition();
+  scene.topology = TopologicalMap();
+  std::vector<std::vector<Eigen::Vector3f>> points;
+  const int groups = 6000;
+  for (int g = 0; g < groups; ++g) {
+    LocalMapFrame node;
+    for (int k = 0; k < 2; ++k) {
+      const int i = int(scene.poses.size());
+      Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+      pose.translation() << 0.5 * g + 0.2 * k, 0, 0;
+      scene.poses.push_back(pose);
+      scene.partition.groups.resize(std::size_t(g) + 1);
+      scene.partition.groups[std::size_t(g)].push_back(i);
+      scene.partition.group_of.push_back(g);
+      node.members.push_back(i), node.member_poses.push_back(Eigen::Isometry3d::Identity());
+      // A wall 60 m to the side: its grey stays out of the poses' blocks.
+      points.push_back({Eigen::Vector3f(float(0.5 * g), 60.f, 0.f)});
+    }
+    node.reference = node.members.front(), node.pose = scene.poses[std::size_t(node.reference)];
+    scene.topology.nodes.push_back(node);
+  }
+  scene.world = WorldPoints();
+  scene.world.appendAll(points, 1);
+  double total = 0;
+  for (int g = 0; g + 1 < groups; ++g) scene.arc(g, g + 1, 1.0 + g % 3), total += 1.0 + g % 3;
+  const MapLayout layout = scene.layout();
+  ASSERT_TRUE(layout.coarse);
+  EXPECT_LT(layout.spacing, 4.0);
+  // The arcs summed between blocks: fewer lines, each between two blocks,
+  // together no more than every arc.
+  ASSERT_FALSE(layout.coarse_arcs.empty());
+  EXPECT_LT(layout.coarse_arcs.size(), scene.topology.arcs.size() / 10);
+  std::size_t summed = 0;
+  double weight = 0;
+  for (const auto& line : layout.coarse_arcs) {
+    EXPECT_GE(line.arcs, 1u);
+    EXPECT_GE((line.to - line.from).norm(), 1.0);
+    summed += line.arcs, weight += line.weight;
+  }
+  EXPECT_GE(summed, layout.coarse_arcs.size());
+  EXPECT_LE(summed, scene.topology.arcs.size());
+  EXPECT_LE(weight, total);
+  std::size_t numbered = std::size_t(std::count(layout.numbered.begin(), layout.numbered.end(), 1));
+  EXPECT_GT(numbered, 10u);
+  EXPECT_LT(numbered, std::size_t(groups) / 10);
+
+  {
+    const Png png(writeMap(scene));
+    ASSERT_TRUE(png.ok());
+    EXPECT_EQ(png.width(), layout.view.width);
+  }
+
+  // Each block holding observations is a shade between white and the colour
+  // of the group with most observations there (ties: the lower group); seen
+  // without the arcs, which run along the route.
+  scene.topology.arcs.clear();
+  const MapLayout bare = scene.layout();
+  ASSERT_TRUE(bare.coarse);
+  const Png png(writeMap(scene));
+  ASSERT_TRUE(png.ok());
+  const render::PictureView& v = bare.view;
+  std::map<std::pair<int, int>, std::map<int, int>> counts;  // block: group: observations
+  for (std::size_t i = 0; i < scene.poses.size(); ++i) {
+    const int x = int(v.px(scene.poses[i].translation().x())), y = int(v.py(scene.poses[i].translation().y()));
+    ++counts[{x / bare.block, y / bare.block}][scene.partition.group_of[i]];
+  }
+  int checked = 0, shaded = 0;
+  for (const auto& [block, of_group] : counts) {
+    int best = -1, most = 0;
+    for (const auto& [g, n] : of_group)
+      if (n > most) best = g, most = n;
+    // A pixel of the block away from any number's circle and the arcs' line.
+    const int x = block.first * bare.block, y = block.second * bare.block;
+    bool clear = true;
+    for (std::size_t g = 0; g < bare.centres.size(); ++g)
+      if (bare.numbered[g] && (bare.centres[g] - Eigen::Vector2d(x, y)).norm() < bare.label_radius + 6) clear = false;
+    if (!clear || y >= bare.legend_top) continue;
+    ++checked;
+    const std::string hex = render::paletteHex(bare.colours[std::size_t(best)]);
+    const int c[3] = {std::stoi(hex.substr(1, 2), nullptr, 16), std::stoi(hex.substr(3, 2), nullptr, 16),
+                      std::stoi(hex.substr(5, 2), nullptr, 16)};
+    const std::uint32_t rgb = png.rgb(x, y);
+    const int p[3] = {int(rgb >> 16), int((rgb >> 8) & 255), int(rgb & 255)};
+    // p = 255 - t (255 - c) for one t in [0.3, 1] on every channel
+    double t = -1;
+    bool fits = true;
+    for (int k = 0; k < 3; ++k) {
+      if (255 - c[k] < 40) continue;
+      const double tk = double(255 - p[k]) / (255 - c[k]);
+      if (t < 0) t = tk;
+      fits = fits && std::abs(tk - t) < 0.05;
+    }
+    shaded += fits && t >= 0.29 && t <= 1.01;
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_EQ(shaded, checked);
 }
 
 TEST_F(Pictures, LocalMapsHaveAScaleBar) {

@@ -426,6 +426,70 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
   return surface;
 }
 
+/// A coarse map's drawing (MapLayout::coarse), opaque, above the legend:
+/// each block of `layout.block` pixels that holds observations in the colour
+/// of the group with most of them there (ties: the lower group), from pale
+/// for one to full colour for the most any block holds (on a log scale);
+/// the points over it in translucent grey, darker where more fall.
+Surface rasterDensity(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions,
+                      const Partition& partition, const MapLayout& layout) {
+  View v = layout.view;
+  v.height = layout.legend_top;
+  Surface surface = imageSurface(v.width, v.height);
+  cairo_surface_flush(surface.get());
+  unsigned char* data = cairo_image_surface_get_data(surface.get());
+  const int stride = cairo_image_surface_get_stride(surface.get());
+  for (int y = 0; y < v.height; ++y) std::fill_n(reinterpret_cast<std::uint32_t*>(data + y * stride), v.width, 0xffffffffu);
+  const int side = layout.block, columns = (v.width + side - 1) / side;
+  std::vector<std::uint64_t> entries;  // (block << 32) | group, one per observation in the picture
+  entries.reserve(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const double fx = v.px(positions[i].x()), fy = v.py(positions[i].y());
+    if (!(fx >= 0 && fy >= 0 && fx < v.width && fy < v.height)) continue;
+    const std::uint64_t block = std::uint64_t(int(fy) / side) * columns + std::uint64_t(int(fx) / side);
+    entries.push_back((block << 32) | std::uint32_t(partition.group_of[i]));
+  }
+  std::sort(entries.begin(), entries.end());
+  struct Block {
+    std::uint64_t block;
+    int group;
+    std::size_t count;
+  };
+  std::vector<Block> blocks;
+  std::size_t most = 1;
+  for (std::size_t a = 0; a < entries.size();) {
+    Block b{entries[a] >> 32, -1, 0};
+    std::size_t best = 0;
+    while (a < entries.size() && (entries[a] >> 32) == b.block) {
+      std::size_t e = a;
+      while (e < entries.size() && entries[e] == entries[a]) ++e;
+      if (e - a > best) best = e - a, b.group = int(entries[a] & 0xffffffffu);  // ascending: ties keep the lower
+      b.count += e - a;
+      a = e;
+    }
+    most = std::max(most, b.count);
+    blocks.push_back(b);
+  }
+  for (const Block& b : blocks) {
+    const Rgb c = paletteColour(layout.colours[std::size_t(b.group)]);
+    const double t = 0.3 + 0.7 * std::log1p(double(b.count)) / std::log1p(double(most));
+    const std::uint32_t argb = argbOf({1 - t + t * c.r, 1 - t + t * c.g, 1 - t + t * c.b});
+    const int x0 = int(b.block % columns) * side, y0 = int(b.block / columns) * side;
+    for (int y = y0; y < std::min(v.height, y0 + side); ++y)
+      for (int x = x0; x < std::min(v.width, x0 + side); ++x) reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = argb;
+  }
+  for (const Eigen::Vector3f& p : world.points) {
+    const double fx = v.px(p.x()), fy = v.py(p.y());
+    if (!(fx >= 0 && fy >= 0 && fx < v.width && fy < v.height)) continue;
+    std::uint32_t& pixel = reinterpret_cast<std::uint32_t*>(data + int(fy) * stride)[int(fx)];
+    const auto toward_grey = [](std::uint32_t channel) { return (channel * 3 + 0x50) / 4; };  // a quarter of the way
+    pixel = 0xff000000u | (toward_grey((pixel >> 16) & 255u) << 16) | (toward_grey((pixel >> 8) & 255u) << 8) |
+            toward_grey(pixel & 255u);
+  }
+  cairo_surface_mark_dirty(surface.get());
+  return surface;
+}
+
 /// An arrow from (x, y), in pixels, `length` long towards `heading` (radians
 /// from the x axis, counter-clockwise as seen from above); stroke it after.
 void arrowPath(cairo_t* cr, double x, double y, double heading, double length) {
@@ -476,7 +540,12 @@ constexpr int kLegendHeight = 90;  ///< map.png's legend band
 /// of 1,000 are both readable.
 struct MarkSizes {
   double label_radius = 11, dot_radius = 5, arc_width = 3, arrow = 10, arrow_width = 1.5;
+  double spacing = 60;  ///< median pixels from a group's mark to the nearest other
 };
+
+/// Below this median spacing of the group marks, in pixels, a group's dot
+/// would cover its neighbours': map.png is drawn coarse (MapLayout::coarse).
+constexpr double kCoarseSpacing = 4.0;
 
 /// Each centre's distance to the nearest other one, by a kd-tree: a million
 /// scans make 50,000 groups, and all pairs would be 2.5 billion distances.
@@ -515,6 +584,7 @@ MarkSizes markSizes(const MapLayout& layout, std::size_t observations) {
   s.arc_width = std::clamp(0.15 * spacing, 1.2, 3.5);
   s.arrow = std::clamp(0.5 * layout.view.scale, 6.0, 12.0);
   s.arrow_width = observations > 500 ? 1.0 : 1.5;
+  s.spacing = spacing;
   return s;
 }
 
@@ -528,6 +598,55 @@ std::vector<Eigen::Vector2d> groupCentres(const View& v, const std::vector<Eigen
     centres[g] = Eigen::Vector2d(v.px(centres[g].x()), v.py(centres[g].y()));
   }
   return centres;
+}
+
+/// The arcs of the topology summed between blocks of `layout.arc_block`
+/// pixels: one line per pair of blocks, between the mean mark of each
+/// block's groups; arcs within one block are left out. Ordered by the pair
+/// of blocks (row, column).
+std::vector<MapLayout::BlockArc> blockArcs(const MapLayout& layout, const TopologicalMap& topology) {
+  const double side = layout.arc_block;
+  const auto blockOf = [&](const Eigen::Vector2d& c) {
+    return std::pair<long, long>(long(std::floor(c.y() / side)), long(std::floor(c.x() / side)));
+  };
+  std::map<std::pair<long, long>, std::pair<Eigen::Vector2d, int>> marks;  // block: sum of marks, count
+  for (const Eigen::Vector2d& c : layout.centres) {
+    auto& [sum, count] = marks.try_emplace(blockOf(c), Eigen::Vector2d::Zero(), 0).first->second;
+    sum += c, ++count;
+  }
+  std::map<std::pair<std::pair<long, long>, std::pair<long, long>>, MapLayout::BlockArc> summed;
+  for (const TopologicalArc& arc : topology.arcs) {
+    if (arc.from < 0 || arc.to < 0 || std::size_t(std::max(arc.from, arc.to)) >= layout.centres.size()) continue;
+    auto a = blockOf(layout.centres[std::size_t(arc.from)]), b = blockOf(layout.centres[std::size_t(arc.to)]);
+    if (a == b) continue;
+    if (b < a) std::swap(a, b);
+    MapLayout::BlockArc& line = summed[{a, b}];
+    if (line.arcs == 0) {
+      line.from = marks.at(a).first / marks.at(a).second;
+      line.to = marks.at(b).first / marks.at(b).second;
+    }
+    line.weight += arc.weight;
+    ++line.arcs;
+  }
+  std::vector<MapLayout::BlockArc> lines;
+  lines.reserve(summed.size());
+  for (const auto& entry : summed) lines.push_back(entry.second);
+  return lines;
+}
+
+/// The summed arcs of a coarse map, thicker and darker for a larger sum.
+void drawBlockArcs(cairo_t* cr, const MapLayout& layout) {
+  double strongest = 0.0;
+  for (const auto& line : layout.coarse_arcs) strongest = std::max(strongest, line.weight);
+  for (const auto& line : layout.coarse_arcs) {
+    const double strength = strongest > 0.0 ? line.weight / strongest : 0.0;
+    // Translucent and thin: on a coarse map the arcs run along the density they join.
+    cairo_set_source_rgba(cr, 0.15, 0.15, 0.15, 0.3 + 0.4 * strength);
+    cairo_set_line_width(cr, std::max(1.0, 2.5 * std::sqrt(strength)));
+    cairo_move_to(cr, line.from.x(), line.from.y());
+    cairo_line_to(cr, line.to.x(), line.to.y());
+    cairo_stroke(cr);
+  }
 }
 
 /// Each shown arc as a solid grey line between the group centres, thicker
@@ -627,6 +746,8 @@ struct LegendText {
   std::size_t observations = 0, groups = 0, numbered = 0, arcs = 0, shown_arcs = 0, outside = 0;
   bool regions = false;
   bool places = false;
+  bool coarse = false;
+  int block = 4, arc_block = 24;
 };
 
 /// The legend's first row, at `row`: a group's circle, a dot (when some
@@ -636,6 +757,22 @@ void legendMarks(cairo_t* cr, const View& v, double row, const LegendText& t, co
   groupMark(cr, v.margin + 11, row, 7, sample, true, sizes);
   cairo_set_source_rgb(cr, 0, 0, 0);
   double x = v.margin + 28;
+  if (t.coarse) {
+    x += text(cr, x, row + 4, "group, numbered where there is room", 12) + 14;
+    for (int k = 0; k < 4; ++k) {  // the density scale: one observation to the most
+      const double s = 0.3 + 0.7 * k / 3.0;
+      cairo_set_source_rgb(cr, 1 - s + s * sample.r, 1 - s + s * sample.g, 1 - s + s * sample.b);
+      cairo_rectangle(cr, x + 13 * k, row - 6, 12, 12);
+      cairo_fill(cr);
+    }
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    char density[160];
+    std::snprintf(density, sizeof density, "observations per %d-pixel block, pale few to full many, in the colour of the"
+                  " group with most there; grey: points", t.block);
+    text(cr, x + 58, row + 4, density, 12);
+    drawScaleBar(cr, v.scale, std::min(320.0, (v.width - 2 * v.margin) / 4.0), v.width - v.margin, row + 2);
+    return;
+  }
   x += text(cr, x, row + 4, t.places ? "group, on its floor" : "group, at its observations' mean", 12) + 14;
   if (t.numbered < t.groups) {
     groupMark(cr, x + 5, row, 0, sample, false, sizes);
@@ -663,10 +800,14 @@ void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendTex
   cairo_stroke(cr);
   cairo_set_source_rgb(cr, 0, 0, 0);
   char arcs[200];
-  std::snprintf(arcs, sizeof arcs, "arc of the topology, thicker = larger cut weight: the %d strongest of each group"
-                " (%zu of %zu; all in topology.json)", kArcsPerGroup, t.shown_arcs, t.arcs);
+  if (t.coarse)
+    std::snprintf(arcs, sizeof arcs, "arcs of the topology summed between %d-pixel blocks, thicker = larger summed cut"
+                  " weight (%zu lines for %zu arcs; all in topology.json)", t.arc_block, t.shown_arcs, t.arcs);
+  else
+    std::snprintf(arcs, sizeof arcs, "arc of the topology, thicker = larger cut weight: the %d strongest of each group"
+                  " (%zu of %zu; all in topology.json)", kArcsPerGroup, t.shown_arcs, t.arcs);
   const double x = x0 + 28 + text(cr, x0 + 28, row + 4, arcs, 12) + 14;
-  if (t.regions) {
+  if (t.regions && !t.coarse) {
     const Rgb p = pale(paletteColour(0));
     cairo_set_source_rgb(cr, p.r, p.g, p.b);
     cairo_rectangle(cr, x, row - 6, 12, 12);
@@ -680,9 +821,14 @@ void legendArcsAndCounts(cairo_t* cr, const View& v, double row, const LegendTex
   if (t.outside > 0)
     std::snprintf(outside, sizeof outside, "; %zu far point%s outside the picture", t.outside,
                   t.outside == 1 ? "" : "s");
-  std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered); neighbouring groups differ in"
-                " colour%s%s", t.observations, t.groups, t.numbered,
-                t.places ? "; lines: each place's floor, black bars: doors (places.json)" : "", outside);
+  if (t.coarse)
+    std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered): too close together at this scale"
+                  " for a mark each, drawn as a density%s%s", t.observations, t.groups, t.numbered,
+                  t.places ? "; outlines and doors in places.json" : "", outside);
+  else
+    std::snprintf(caption, sizeof caption, "%zu observations, %zu groups (%zu numbered); neighbouring groups differ in"
+                  " colour%s%s", t.observations, t.groups, t.numbered,
+                  t.places ? "; lines: each place's floor, black bars: doors (places.json)" : "", outside);
   text(cr, x0, row + 24, caption, 12);
 }
 
@@ -736,20 +882,31 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
   cairo_paint(cr);
   cairo_set_source_surface(cr, points, 0, 0);
   cairo_paint(cr);
-  if (places) drawPlaces(cr, layout, *places, origin);
   const MarkSizes sizes = markSizes(layout, positions.size());
-  drawArcs(cr, layout, topology, sizes);
-  drawPoses(cr, layout, positions, headings, partition, sizes);
-  drawGroupMarks(cr, layout, sizes);
+  if (layout.coarse) {  // outlines, doors, arrows and dots would be smaller than a pixel
+    drawBlockArcs(cr, layout);
+    for (std::size_t g = 0; g < layout.centres.size(); ++g)
+      if (layout.numbered[g])
+        groupMark(cr, layout.centres[g].x(), layout.centres[g].y(), int(g), paletteColour(layout.colours[g]), true,
+                  sizes);
+  } else {
+    if (places) drawPlaces(cr, layout, *places, origin);
+    drawArcs(cr, layout, topology, sizes);
+    drawPoses(cr, layout, positions, headings, partition, sizes);
+    drawGroupMarks(cr, layout, sizes);
+  }
   LegendText legend;
   legend.numbered = std::size_t(std::count(layout.numbered.begin(), layout.numbered.end(), 1));
   legend.observations = positions.size();
   legend.groups = partition.groups.size();
   legend.arcs = topology.arcs.size();
-  legend.shown_arcs = layout.shown_arcs.size();
+  legend.shown_arcs = layout.coarse ? layout.coarse_arcs.size() : layout.shown_arcs.size();
   legend.outside = layout.points_outside;
   legend.regions = regions;
   legend.places = places != nullptr;
+  legend.coarse = layout.coarse;
+  legend.block = layout.block;
+  legend.arc_block = layout.arc_block;
   drawLegend(cr, layout, legend, sizes);
 }
 
@@ -796,6 +953,9 @@ MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>&
   const MarkSizes sizes = markSizes(layout, positions.size());
   layout.label_radius = sizes.label_radius;
   layout.numbered = numberedGroups(layout.centres, partition, sizes);
+  layout.spacing = sizes.spacing;
+  layout.coarse = layout.centres.size() > 1 && sizes.spacing < kCoarseSpacing;
+  if (layout.coarse) layout.coarse_arcs = blockArcs(layout, topology);
   for (const Eigen::Vector3f& p : world.points) {
     const double x = layout.view.px(p.x()), y = layout.view.py(p.y());
     layout.points_outside += !(x >= 0 && y >= 0 && x < layout.view.width && y < layout.legend_top);
@@ -955,7 +1115,8 @@ void writeMapPictures(const PictureWriter& out, const WorldPoints& input_world,
   }
   const MapLayout layout = layoutOf(world, positions, partition, topology, places);
   // The regions describe the input poses (they gave W) and stay there.
-  const Surface points = rasterPoints(world, partition, layout, regions, places, band, heights);
+  const Surface points = layout.coarse ? rasterDensity(world, positions, partition, layout)
+                                       : rasterPoints(world, partition, layout, regions, places, band, heights);
   const auto draw = [&](cairo_surface_t* target, std::vector<SvgText>* texts) {
     Context cr(cairo_create(target), cairo_destroy);
     if (texts) recordTextInto(cr.get(), texts);

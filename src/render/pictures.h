@@ -57,6 +57,22 @@ struct MapLayout {
   std::vector<char> numbered;
   double label_radius = 11;
   std::size_t points_outside = 0;        ///< Points beyond the crop (not drawn).
+  /// The level of detail. A map whose groups lie closer together than a few
+  /// pixels (tens of thousands of groups on one canvas) is drawn coarse:
+  /// the observations as a density on blocks of `block` pixels, each in the
+  /// colour of the group with most observations there; the points in grey;
+  /// the arcs summed between blocks of `arc_block` pixels (`coarse_arcs`);
+  /// numbered groups where they fit and no dots, pose arrows, outlines or
+  /// doors, which would be smaller than a pixel.
+  bool coarse = false;
+  double spacing = 0;                    ///< median pixels from a group's mark to the nearest other
+  int block = 4, arc_block = 24;
+  struct BlockArc {
+    Eigen::Vector2d from, to;            ///< pixels: the mean mark of the groups of each block
+    double weight = 0;                   ///< the sum of the cut weights of the arcs between them
+    std::size_t arcs = 0;                ///< how many arcs of the topology it sums
+  };
+  std::vector<BlockArc> coarse_arcs;
 };
 
 /// 3D input seen from above: only the points whose height above their
@@ -79,7 +95,8 @@ MapLayout mapLayout(const WorldPoints& world, const std::vector<Eigen::Isometry3
 /// numbers would overlap), the strongest arcs (shownArcs(), thicker for a
 /// larger cut weight), a legend saying so and a scale bar; see mapLayout().
 /// Marker sizes and line widths follow the spacing of the groups in the
-/// picture, which grows with their number. With regions, each cell is first
+/// picture, which grows with their number; groups too close together for
+/// their own marks are drawn at a coarser level of detail (MapLayout::coarse). With regions, each cell is first
 /// tinted with the colour of the group most of whose observations hold it.
 /// `world` holds the points at the input `poses` (the frame of `world` before
 /// re-centring); each observation is drawn at `drawn[i]` (globalPoses()),
