@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <pty.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -873,6 +874,57 @@ int runInterruptedAfter(const std::vector<std::string>& args, std::chrono::milli
   return exitCode(status);
 }
 
+/// Runs the command with its standard error on a terminal, where it draws
+/// its progress bar, and sends SIGINT as soon as the bar of `stage` shows:
+/// the run is then in that stage, its handler installed, whatever the
+/// machine's load. Returns its exit code and the stages whose bars it drew
+/// (in `stages`); kNotStarted when no terminal or process could be had.
+int runInterruptedAtStage(const std::vector<std::string>& args, const std::string& stage,
+                          std::vector<std::string>* stages = nullptr) {
+  int master = -1, slave = -1;
+  if (::openpty(&master, &slave, nullptr, nullptr, nullptr) != 0) return kNotStarted;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(OBSGROUP_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::close(master);
+    std::freopen("/dev/null", "w", stdout);
+    ::dup2(slave, 2);
+    ::close(slave);
+    ::execv(OBSGROUP_EXE, argv.data());
+    std::_Exit(127);
+  }
+  ::close(slave);
+  if (pid < 0) {
+    ::close(master);
+    return kNotStarted;
+  }
+  std::string shown;
+  bool sent = false;
+  char buffer[4096];
+  for (;;) {  // to the end (EIO once the command has closed the terminal), so that it never blocks on it
+    const ssize_t n = ::read(master, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    shown.append(buffer, std::size_t(n));
+    if (!sent && shown.find("\r" + stage + " [") != std::string::npos) sent = ::kill(pid, SIGINT) == 0;
+  }
+  ::close(master);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  if (stages)
+    for (std::size_t at = shown.find('\r'); at != std::string::npos; at = shown.find('\r', at + 1)) {
+      const std::size_t bar = shown.find(" [", at);
+      if (bar == std::string::npos) break;
+      const std::string name = shown.substr(at + 1, bar - at - 1);
+      if (!name.empty() && name.find_first_of("\r\n\033") == std::string::npos &&
+          std::find(stages->begin(), stages->end(), name) == stages->end())
+        stages->push_back(name);
+    }
+  return exitCode(status);
+}
+
 /// Runs the command and sends SIGINT as soon as it prints a line starting
 /// with `prefix` on stdout (its handler is installed before it prints
 /// anything); returns its exit code. A command that never prints the line
@@ -935,20 +987,44 @@ TEST_F(Cli, InterruptedRunLeavesTheOldResultsOrTheNewOnes) {
   ASSERT_EQ(run("partition " + input + " -q -o " + out.string()).code, 0);
   const auto old_results = snapshot(out);
   ASSERT_GT(old_results.size(), 8u);
-  // Ctrl-C at every stage of a rerun with other parameters: reading, overlap,
-  // partition, local maps, pictures, the swap. Each outcome is whole.
-  bool saw_interrupted = false, saw_completed = false;
+  const std::vector<std::string> rerun{"partition", input, "--paper", "--delta", "0.2", "--force", "--threads", "1",
+                                       "-o", out.string()};
+  // Ctrl-C in each stage of a rerun with other parameters, struck when the
+  // stage's progress bar shows (the command's handler is then installed,
+  // however busy the machine): the old results stay, whole. The first stage
+  // leaves the run much more to do than the test takes to strike, so it must
+  // end it; after the last ones the run may have finished first, and then
+  // its results must be whole.
+  auto results = old_results;
+  bool saw_interrupted = false;
+  for (const std::string stage : {"overlap", "local maps", "places", "pictures"}) {
+    std::vector<std::string> stages;
+    const int code = runInterruptedAtStage(rerun, stage, &stages);
+    if (code == kNotStarted) break;  // no terminal to draw a bar on
+    EXPECT_NE(std::find(stages.begin(), stages.end(), stage), stages.end()) << stage << " never showed";
+    if (stage == "overlap") {
+      EXPECT_EQ(code, 130) << stage;
+    }
+    ASSERT_TRUE(code == 130 || code == 0) << "exit code " << code << " in " << stage;
+    saw_interrupted = saw_interrupted || code == 130;
+    if (code == 130) {
+      EXPECT_EQ(snapshot(out), results) << "interrupted in " << stage << " left a changed folder";
+    } else {
+      results = snapshot(out);
+      EXPECT_EQ(nlohmann::json::parse(results.at("partition.json")).at("parameters").at("delta"), 0.2);
+    }
+  }
+  // Ctrl-C at any moment, the swap too: each outcome is whole.
+  bool saw_completed = false;
   // Ends at the first completed run: every 30 ms at first, then by half as
   // much again, so that a slow (busy) machine completes one too.
   for (int ms = 0; !saw_completed; ms = ms < 900 ? ms + 30 : ms * 3 / 2) {
-    const int code = runInterruptedAfter(
-        {"partition", input, "--paper", "--delta", "0.2", "--force", "--threads", "1", "-o", out.string()},
-        std::chrono::milliseconds(ms));
+    const int code = runInterruptedAfter(rerun, std::chrono::milliseconds(ms));
     ASSERT_TRUE(code == 130 || code == 0 || code == -SIGINT) << "exit code " << code << " at " << ms << " ms";
     const auto now = snapshot(out);
     if (code != 0) {
       saw_interrupted = saw_interrupted || code == 130;
-      EXPECT_EQ(now, old_results) << "interrupted at " << ms << " ms left a changed folder";
+      EXPECT_EQ(now, results) << "interrupted at " << ms << " ms left a changed folder";
     } else {
       saw_completed = true;
       const auto partition = nlohmann::json::parse(now.at("partition.json"));
