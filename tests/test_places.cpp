@@ -9,6 +9,7 @@
 #include <obsgroup/places/place_map.h>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <atomic>
 #include <cmath>
@@ -254,6 +255,52 @@ TEST(Places, PointsAskedForOneObservationAtATimeGiveTheSamePlaces) {
   EXPECT_THROW(buildPlaceMap(grouping.getRegions(), observations[0].pose.translation(), failing, sensors,
                              partition.groups, ids),
                std::runtime_error);
+}
+
+TEST(Places, TheSamePlacesForAnyThreadCount) {
+  // Each thread takes its share of the groups to find each cell's owner; ties
+  // (equal shares) go to the lower group whichever thread saw which.
+  const sim::Building office = sim::makeBuilding("office");
+  std::vector<sim::Pose2D> route;
+  for (std::size_t k = 0; k < office.route.size(); k += 2) route.push_back(office.route[k]);
+  for (const bool three_d : {false, true}) {
+    const auto observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
+                                      : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    grouping.setKeepRegions(true);
+    grouping.setKeepWorldPoints(true);
+    for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+    const Partition partition = grouping.compute();
+    const WorldPoints& world = grouping.getWorldPoints();
+    std::vector<Eigen::Vector3d> sensors;
+    for (const auto& o : observations) sensors.push_back(o.pose.translation() - world.origin);
+    // The grouping's groups, and one group per observation: every cell that
+    // several observations hold is then a tie.
+    std::vector<std::vector<int>> singles(observations.size());
+    for (std::size_t i = 0; i < singles.size(); ++i) singles[i] = {int(i)};
+    for (const auto& groups : {partition.groups, singles}) {
+      std::vector<int> ids(groups.size());
+      std::iota(ids.begin(), ids.end(), 0);
+      std::vector<PlaceMap> maps;
+      const int before = omp_get_max_threads();
+      for (const int threads : {1, 2, 3, 5}) {
+        omp_set_num_threads(threads);
+        maps.push_back(buildPlaceMap(grouping.getRegions(), world, sensors, groups, ids));
+      }
+      omp_set_num_threads(before);
+      ASSERT_GT(maps[0].places.size(), 3u);
+      for (std::size_t m = 1; m < maps.size(); ++m) {
+        EXPECT_EQ(maps[m].labels, maps[0].labels) << "3D: " << three_d << ", map " << m;
+        EXPECT_EQ(maps[m].occupancy, maps[0].occupancy) << "3D: " << three_d;
+        ASSERT_EQ(maps[m].places.size(), maps[0].places.size());
+        for (std::size_t k = 0; k < maps[0].places.size(); ++k)
+          EXPECT_EQ(maps[m].places[k].outline, maps[0].places[k].outline);
+        ASSERT_EQ(maps[m].doors.size(), maps[0].doors.size());
+        for (std::size_t k = 0; k < maps[0].doors.size(); ++k)
+          EXPECT_EQ(maps[m].doors[k].midpoint, maps[0].doors[k].midpoint);
+      }
+    }
+  }
 }
 
 TEST(Places, BadArgumentsAreRefused) {

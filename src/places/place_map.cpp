@@ -197,45 +197,76 @@ class FloorCellOfKey {
 };
 
 /// Per floor cell, the group the largest share of whose observations hold
-/// it (ties: the lower group), or kNone. Groups are taken in order, each
-/// counting its observations per cell once (a 3D region's voxels above one
-/// cell count once), so no sort of all the cells is needed.
+/// it (ties: the lower group), or kNone. Each thread takes its share of the
+/// groups, each group counting its observations per cell once (a 3D
+/// region's voxels above one cell count once), so no sort of all the cells
+/// is needed; the threads' owners are then merged by the same exact rule,
+/// which does not depend on the order the groups were taken in, so the
+/// owners are the same for any thread count.
 std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCellOfKey& cell_of,
                               const std::vector<std::vector<int>>& groups, const std::vector<Occupancy>& occupancy) {
   const std::size_t cells = occupancy.size();
-  std::vector<int> owner(cells, kNone);
-  std::vector<std::uint32_t> best_count(cells, 0), count(cells, 0);
   // Plane cells of one region are distinct; voxels stacked above a cell are not.
   const bool stacked = !regions.planar;
-  std::vector<std::uint32_t> seen_by(stacked ? cells : 0, 0);
-  std::vector<std::uint32_t> touched;
-  std::uint32_t stamp = 0;  // which observation last counted a cell (its position + 1)
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    touched.clear();
-    for (int i : groups[g]) {
-      ++stamp;
-      regions.forEachCell(i, [&](std::uint64_t key) {
-        const std::size_t c = cell_of(key);
-        if (stacked) {
-          if (seen_by[c] == stamp) return;  // another voxel of this observation above the cell
-          seen_by[c] = stamp;
+  // Group g's share count / size beats group h's: compared exactly, ties to the lower group.
+  const auto beats = [&](std::uint64_t count, int g, std::uint64_t best_count, int h) {
+    if (h == kNone) return true;
+    const std::uint64_t a = count * groups[std::size_t(h)].size(), b = best_count * groups[std::size_t(g)].size();
+    return a > b || (a == b && g < h);
+  };
+  struct Owners {
+    std::vector<int> owner;
+    std::vector<std::uint32_t> best_count, count, seen_by, touched;
+    std::uint32_t stamp = 0;  // which observation last counted a cell (its position + 1)
+  };
+  constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
+  const std::size_t bytes_per_thread = std::max<std::size_t>(1, cells * (stacked ? 16 : 12));
+  const int threads = std::max(1, std::min({omp_get_max_threads(), int(groups.size()),
+                                            int(std::min<std::size_t>(kMaxCopiedBytes / bytes_per_thread, 64))}));
+  std::list<Owners> per_thread;  // a list, so that each stays where it was made
+  std::mutex per_thread_mutex;
+  parallelForWithScratch(
+      groups.size(), threads, 1,
+      [&] {
+        std::lock_guard<std::mutex> lock(per_thread_mutex);
+        Owners& o = per_thread.emplace_back();
+        o.owner.assign(cells, kNone);
+        o.best_count.assign(cells, 0);
+        o.count.assign(cells, 0);
+        if (stacked) o.seen_by.assign(cells, 0);
+        return &o;
+      },
+      [&](std::size_t g, Owners* o) {
+        o->touched.clear();
+        for (int i : groups[g]) {
+          ++o->stamp;
+          regions.forEachCell(i, [&](std::uint64_t key) {
+            const std::size_t c = cell_of(key);
+            if (stacked) {
+              if (o->seen_by[c] == o->stamp) return;  // another voxel of this observation above the cell
+              o->seen_by[c] = o->stamp;
+            }
+            if (o->count[c]++ == 0) o->touched.push_back(std::uint32_t(c));
+          });
         }
-        if (count[c]++ == 0) touched.push_back(std::uint32_t(c));
+        for (std::uint32_t c : o->touched) {
+          if (occupancy[c] == Occupancy::Free && beats(o->count[c], int(g), o->best_count[c], o->owner[c])) {
+            o->owner[c] = int(g);
+            o->best_count[c] = o->count[c];
+          }
+          o->count[c] = 0;
+        }
       });
-    }
-    const std::uint64_t size = groups[g].size();
-    for (std::uint32_t c : touched) {
-      // count / size > best_count / best_size, compared exactly.
-      if (occupancy[c] == Occupancy::Free &&
-          (owner[c] == kNone ||
-           std::uint64_t(count[c]) * groups[std::size_t(owner[c])].size() > std::uint64_t(best_count[c]) * size)) {
-        owner[c] = int(g);
-        best_count[c] = count[c];
+  if (per_thread.empty()) return std::vector<int>(cells, kNone);
+  Owners& merged = per_thread.front();
+  for (auto other = std::next(per_thread.begin()); other != per_thread.end(); ++other)
+    for (std::size_t c = 0; c < cells; ++c)
+      if (other->owner[c] != kNone &&
+          beats(other->best_count[c], other->owner[c], merged.best_count[c], merged.owner[c])) {
+        merged.owner[c] = other->owner[c];
+        merged.best_count[c] = other->best_count[c];
       }
-      count[c] = 0;
-    }
-  }
-  return owner;
+  return std::move(merged.owner);
 }
 
 /// The free cell an observation stands in goes to its own group (to the
