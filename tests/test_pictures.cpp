@@ -354,6 +354,11 @@ TEST_F(Pictures, GroupsTooCloseForTheirMarksAreDrawnAsADensity) {
   // pixel apart on the canvas, each joined to the next.
   Scene scene;
   EXPECT_FALSE(scene.layout().coarse);  // four rooms: a mark each
+  {
+    Scene still;  // every observation at one spot (a robot standing still): still a mark each
+    for (auto& pose : still.poses) pose = still.poses.front();
+    EXPECT_FALSE(still.layout().coarse);
+  }
   scene.poses.clear();
   scene.partition = Partition();
   scene.topology = TopologicalMap();

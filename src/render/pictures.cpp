@@ -546,6 +546,7 @@ struct MarkSizes {
 /// Below this median spacing of the group marks, in pixels, a group's dot
 /// would cover its neighbours': map.png is drawn coarse (MapLayout::coarse).
 constexpr double kCoarseSpacing = 4.0;
+constexpr std::size_t kCoarseGroups = 1000;
 
 /// Each centre's distance to the nearest other one, by a kd-tree: a million
 /// scans make 50,000 groups, and all pairs would be 2.5 billion distances.
@@ -954,7 +955,8 @@ MapLayout layoutOf(const WorldPoints& world, const std::vector<Eigen::Vector2d>&
   layout.label_radius = sizes.label_radius;
   layout.numbered = numberedGroups(layout.centres, partition, sizes);
   layout.spacing = sizes.spacing;
-  layout.coarse = layout.centres.size() > 1 && sizes.spacing < kCoarseSpacing;
+  // Many groups, not a few at one spot (a robot standing still), make a map coarse.
+  layout.coarse = layout.centres.size() >= kCoarseGroups && sizes.spacing < kCoarseSpacing;
   if (layout.coarse) layout.coarse_arcs = blockArcs(layout, topology);
   for (const Eigen::Vector3f& p : world.points) {
     const double x = layout.view.px(p.x()), y = layout.view.py(p.y());

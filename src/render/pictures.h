@@ -57,8 +57,9 @@ struct MapLayout {
   std::vector<char> numbered;
   double label_radius = 11;
   std::size_t points_outside = 0;        ///< Points beyond the crop (not drawn).
-  /// The level of detail. A map whose groups lie closer together than a few
-  /// pixels (tens of thousands of groups on one canvas) is drawn coarse:
+  /// The level of detail. A map of 1,000 groups or more whose marks would
+  /// lie less than 4 pixels apart (the median distance to the nearest other;
+  /// tens of thousands of groups on one canvas) is drawn coarse:
   /// the observations as a density on blocks of `block` pixels, each in the
   /// colour of the group with most observations there; the points in grey;
   /// the arcs summed between blocks of `arc_block` pixels (`coarse_arcs`);
