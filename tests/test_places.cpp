@@ -194,20 +194,35 @@ TEST(Places, LocateReturnsTheOwnPlaceOfMostObservations) {
   EXPECT_FALSE(g.places.locate(Eigen::Vector2d(NAN, 0)).place);
 }
 
+/// The simulated office at every `every`-th pose of its route, seen by a
+/// 360-degree laser or (three_d) a depth camera, grouped with its regions kept.
+struct OfficeRun {
+  std::vector<Observation<pcl::PointXYZ>> observations;
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  Partition partition;
+};
+
+void groupOffice(bool three_d, std::size_t every, OfficeRun& run) {
+  const sim::Building office = sim::makeBuilding("office");
+  std::vector<sim::Pose2D> route;
+  for (std::size_t k = 0; k < office.route.size(); k += every) route.push_back(office.route[k]);
+  run.observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
+                             : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
+  run.grouping.setKeepRegions(true);
+  for (const auto& o : run.observations) run.grouping.addObservation(o.cloud, o.pose);
+  run.partition = run.grouping.compute();
+}
+
 /// The same places whether the points are held (WorldPoints) or asked for
 /// one observation at a time (PlacePointSource), in 2D and in 3D (points
 /// above the obstacle band too); a source that throws is rethrown.
 TEST(Places, PointsAskedForOneObservationAtATimeGiveTheSamePlaces) {
-  const sim::Building office = sim::makeBuilding("office");
-  std::vector<sim::Pose2D> route;
-  for (std::size_t k = 0; k < office.route.size(); k += 3) route.push_back(office.route[k]);
   for (const bool three_d : {false, true}) {
-    const auto observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
-                                      : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
-    ObservationGrouping<pcl::PointXYZ> grouping;
-    grouping.setKeepRegions(true);
-    for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-    const Partition partition = grouping.compute();
+    OfficeRun run;
+    groupOffice(three_d, 3, run);
+    const auto& observations = run.observations;
+    const auto& grouping = run.grouping;
+    const Partition& partition = run.partition;
     const auto& sso = grouping.getSensedSpaceOverlap();
     const WorldPoints world = sso.toWorld(observations);
     const Eigen::Vector3d origin = SensedSpaceOverlap<pcl::PointXYZ>::worldOrigin(observations);
@@ -237,12 +252,11 @@ TEST(Places, PointsAskedForOneObservationAtATimeGiveTheSamePlaces) {
     for (std::size_t k = 0; k < held.doors.size(); ++k) EXPECT_EQ(made.doors[k].midpoint, held.doors[k].midpoint);
     EXPECT_GT(std::count(held.occupancy.begin(), held.occupancy.end(), Occupancy::Occupied), 0);
   }
-  const sim::Building office_again = sim::makeBuilding("office");
-  const auto observations = test::simulate<pcl::PointXYZ>(office_again.plan, route, sim::laser360());
-  ObservationGrouping<pcl::PointXYZ> grouping;
-  grouping.setKeepRegions(true);
-  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-  const Partition partition = grouping.compute();
+  OfficeRun run;
+  groupOffice(false, 3, run);
+  const auto& observations = run.observations;
+  const auto& grouping = run.grouping;
+  const Partition& partition = run.partition;
   std::vector<Eigen::Vector3d> sensors;
   for (const auto& o : observations) sensors.push_back(o.pose.translation() - observations[0].pose.translation());
   const PlacePointSource failing = [](int i, std::vector<Eigen::Vector3f>&)
@@ -260,18 +274,13 @@ TEST(Places, PointsAskedForOneObservationAtATimeGiveTheSamePlaces) {
 TEST(Places, TheSamePlacesForAnyThreadCount) {
   // Each thread takes its share of the groups to find each cell's owner; ties
   // (equal shares) go to the lower group whichever thread saw which.
-  const sim::Building office = sim::makeBuilding("office");
-  std::vector<sim::Pose2D> route;
-  for (std::size_t k = 0; k < office.route.size(); k += 2) route.push_back(office.route[k]);
   for (const bool three_d : {false, true}) {
-    const auto observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
-                                      : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
-    ObservationGrouping<pcl::PointXYZ> grouping;
-    grouping.setKeepRegions(true);
-    grouping.setKeepWorldPoints(true);
-    for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-    const Partition partition = grouping.compute();
-    const WorldPoints& world = grouping.getWorldPoints();
+    OfficeRun run;
+    groupOffice(three_d, 2, run);
+    const auto& observations = run.observations;
+    const auto& grouping = run.grouping;
+    const Partition& partition = run.partition;
+    const WorldPoints world = grouping.getSensedSpaceOverlap().toWorld(observations);
     std::vector<Eigen::Vector3d> sensors;
     for (const auto& o : observations) sensors.push_back(o.pose.translation() - world.origin);
     // The grouping's groups, and one group per observation: every cell that

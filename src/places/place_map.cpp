@@ -86,6 +86,10 @@ GridFrame makeGrid(const ObservationRegions& regions, const Eigen::Vector3d& wor
   return f;
 }
 
+/// The most bytes of per-thread tables over the grid a thread may take:
+/// beyond it the work runs on fewer threads (one at the least).
+constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
+
 /// What the beams say of a cell, as bits: one crossed it, a point lies in
 /// it, a point within the obstacle band lies in it.
 enum CellSeen : std::uint8_t { kCrossed = 1, kPoint = 2, kPointInBand = 4 };
@@ -142,7 +146,6 @@ std::vector<std::uint8_t> seenCells(const GridFrame& f, const PlacePointSource& 
                                     const PlaceOptions& options, bool& planar) {
   const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
   const int n = int(sensors.size());
-  constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
   const int threads = std::max(1, std::min({omp_get_max_threads(), n, int(kMaxCopiedBytes / std::max<std::size_t>(cells, 1))}));
   std::list<std::vector<std::uint8_t>> seen;  // one per thread; a list, so that each stays where it was made
   std::mutex seen_mutex;
@@ -219,10 +222,9 @@ std::vector<int> ownerOfCells(const ObservationRegions& regions, const FloorCell
     std::vector<std::uint32_t> best_count, count, seen_by, touched;
     std::uint32_t stamp = 0;  // which observation last counted a cell (its position + 1)
   };
-  constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
   const std::size_t bytes_per_thread = std::max<std::size_t>(1, cells * (stacked ? 16 : 12));
   const int threads = std::max(1, std::min({omp_get_max_threads(), int(groups.size()),
-                                            int(std::min<std::size_t>(kMaxCopiedBytes / bytes_per_thread, 64))}));
+                                            int(kMaxCopiedBytes / bytes_per_thread)}));
   std::list<Owners> per_thread;  // a list, so that each stays where it was made
   std::mutex per_thread_mutex;
   parallelForWithScratch(

@@ -395,18 +395,34 @@ WorldPoints withinBand(const WorldPoints& world, const std::vector<double>& heig
   return kept;
 }
 
+/// A fresh surface for map.png's drawing above the legend, and its pixels,
+/// written directly (cairo_surface_mark_dirty when done).
+struct MapRaster {
+  explicit MapRaster(const MapLayout& layout)
+      : view(layout.view), surface(imageSurface(layout.view.width, layout.legend_top)) {
+    view.height = layout.legend_top;
+    cairo_surface_flush(surface.get());
+    data = cairo_image_surface_get_data(surface.get());
+    stride = cairo_image_surface_get_stride(surface.get());
+  }
+  std::uint32_t& pixel(int x, int y) { return reinterpret_cast<std::uint32_t*>(data + y * stride)[x]; }
+
+  View view;  ///< the layout's, ending at the legend
+  Surface surface;
+  unsigned char* data = nullptr;
+  int stride = 0;
+};
+
 /// The points coloured by group over the tinted regions when there are some,
 /// on a transparent background above the legend. With a band, each
 /// observation's points are drawn by height above its sensor (`heights`).
 Surface rasterPoints(const WorldPoints& world, const Partition& partition, const MapLayout& layout,
                      const ObservationRegions* regions, const PlaceMap* places, const HeightBand* band = nullptr,
                      const std::vector<double>& heights = {}) {
-  View v = layout.view;
-  v.height = layout.legend_top;
-  Surface surface = imageSurface(v.width, v.height);
-  cairo_surface_flush(surface.get());
-  unsigned char* data = cairo_image_surface_get_data(surface.get());
-  const int stride = cairo_image_surface_get_stride(surface.get());
+  MapRaster raster(layout);
+  const View& v = raster.view;
+  unsigned char* data = raster.data;
+  const int stride = raster.stride;
   if (regions && places)
     tintPlaces(*places, layout.colours, world.origin, v, data, stride);
   else if (regions)
@@ -422,8 +438,8 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
       plotPoints(v, world.begin(i), world.end(i), argbOf(paletteColour(layout.colours[partition.group_of[i]])), dot,
                  data, stride);
   }
-  cairo_surface_mark_dirty(surface.get());
-  return surface;
+  cairo_surface_mark_dirty(raster.surface.get());
+  return std::move(raster.surface);
 }
 
 /// A coarse map's drawing (MapLayout::coarse), opaque, above the legend:
@@ -433,13 +449,9 @@ Surface rasterPoints(const WorldPoints& world, const Partition& partition, const
 /// the points over it in translucent grey, darker where more fall.
 Surface rasterDensity(const WorldPoints& world, const std::vector<Eigen::Vector2d>& positions,
                       const Partition& partition, const MapLayout& layout) {
-  View v = layout.view;
-  v.height = layout.legend_top;
-  Surface surface = imageSurface(v.width, v.height);
-  cairo_surface_flush(surface.get());
-  unsigned char* data = cairo_image_surface_get_data(surface.get());
-  const int stride = cairo_image_surface_get_stride(surface.get());
-  for (int y = 0; y < v.height; ++y) std::fill_n(reinterpret_cast<std::uint32_t*>(data + y * stride), v.width, 0xffffffffu);
+  MapRaster raster(layout);
+  const View& v = raster.view;
+  for (int y = 0; y < v.height; ++y) std::fill_n(&raster.pixel(0, y), v.width, 0xffffffffu);
   const int side = layout.block, columns = (v.width + side - 1) / side;
   std::vector<std::uint64_t> entries;  // (block << 32) | group, one per observation in the picture
   entries.reserve(positions.size());
@@ -476,18 +488,18 @@ Surface rasterDensity(const WorldPoints& world, const std::vector<Eigen::Vector2
     const std::uint32_t argb = argbOf({1 - t + t * c.r, 1 - t + t * c.g, 1 - t + t * c.b});
     const int x0 = int(b.block % columns) * side, y0 = int(b.block / columns) * side;
     for (int y = y0; y < std::min(v.height, y0 + side); ++y)
-      for (int x = x0; x < std::min(v.width, x0 + side); ++x) reinterpret_cast<std::uint32_t*>(data + y * stride)[x] = argb;
+      for (int x = x0; x < std::min(v.width, x0 + side); ++x) raster.pixel(x, y) = argb;
   }
   for (const Eigen::Vector3f& p : world.points) {
     const double fx = v.px(p.x()), fy = v.py(p.y());
     if (!(fx >= 0 && fy >= 0 && fx < v.width && fy < v.height)) continue;
-    std::uint32_t& pixel = reinterpret_cast<std::uint32_t*>(data + int(fy) * stride)[int(fx)];
+    std::uint32_t& pixel = raster.pixel(int(fx), int(fy));
     const auto toward_grey = [](std::uint32_t channel) { return (channel * 3 + 0x50) / 4; };  // a quarter of the way
     pixel = 0xff000000u | (toward_grey((pixel >> 16) & 255u) << 16) | (toward_grey((pixel >> 8) & 255u) << 8) |
             toward_grey(pixel & 255u);
   }
-  cairo_surface_mark_dirty(surface.get());
-  return surface;
+  cairo_surface_mark_dirty(raster.surface.get());
+  return std::move(raster.surface);
 }
 
 /// An arrow from (x, y), in pixels, `length` long towards `heading` (radians
@@ -733,9 +745,10 @@ std::vector<char> numberedGroups(const std::vector<Eigen::Vector2d>& centres, co
   return numbered;
 }
 
-/// The groups' marks: numbered circles (MapLayout::numbered), dots elsewhere.
+/// The groups' marks: numbered circles (MapLayout::numbered), dots elsewhere
+/// (none on a coarse map, where they would cover each other).
 void drawGroupMarks(cairo_t* cr, const MapLayout& layout, const MarkSizes& sizes) {
-  for (int pass = 0; pass < 2; ++pass)  // dots first, numbers on top
+  for (int pass = layout.coarse ? 1 : 0; pass < 2; ++pass)  // dots first, numbers on top
     for (std::size_t g = 0; g < layout.centres.size(); ++g)
       if (bool(layout.numbered[g]) == (pass == 1))
         groupMark(cr, layout.centres[g].x(), layout.centres[g].y(), int(g), paletteColour(layout.colours[g]),
@@ -884,18 +897,14 @@ void drawMap(cairo_t* cr, cairo_surface_t* points, const MapLayout& layout,
   cairo_set_source_surface(cr, points, 0, 0);
   cairo_paint(cr);
   const MarkSizes sizes = markSizes(layout, positions.size());
-  if (layout.coarse) {  // outlines, doors, arrows and dots would be smaller than a pixel
+  if (layout.coarse) {  // outlines, doors and arrows would be smaller than a pixel
     drawBlockArcs(cr, layout);
-    for (std::size_t g = 0; g < layout.centres.size(); ++g)
-      if (layout.numbered[g])
-        groupMark(cr, layout.centres[g].x(), layout.centres[g].y(), int(g), paletteColour(layout.colours[g]), true,
-                  sizes);
   } else {
     if (places) drawPlaces(cr, layout, *places, origin);
     drawArcs(cr, layout, topology, sizes);
     drawPoses(cr, layout, positions, headings, partition, sizes);
-    drawGroupMarks(cr, layout, sizes);
   }
+  drawGroupMarks(cr, layout, sizes);
   LegendText legend;
   legend.numbered = std::size_t(std::count(layout.numbered.begin(), layout.numbered.end(), 1));
   legend.observations = positions.size();
