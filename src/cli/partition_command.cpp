@@ -319,6 +319,9 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
 struct OutputTimes {
   double outputs_s = 0.0, pictures_s = 0.0, places_s = 0.0;
   std::size_t map_points = 0;
+  /// The places as report.html shows them (null: none were made), kept so
+  /// that the page need not read places.json back (10 MB at 100,100 scans).
+  nlohmann::json place_outlines;
 };
 
 /// The sensed regions the places are cut from: the grouping's own, or for
@@ -430,6 +433,7 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
       if (const auto g = group_of_place.find(place.id); g != group_of_place.end())
         place.members = of_every_frame.groups[g->second];
     writePlaces(out, written, warn, args.method.threads);
+    t.place_outlines = io::placeOutlinesJson(written);
   }
   bar(2, 2);
   bar.finish();
@@ -446,19 +450,33 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   return t;
 }
 
-/// report.html, from the results staged so far: partition.json, places.json
-/// and the local-map pictures (inside the page up to kReportPictureBytes in
+/// report.html, from the run's record, its places and the local-map
+/// pictures staged so far (inside the page up to kReportPictureBytes in
 /// all; beyond, linked beside it, so that a run of thousands of places does
 /// not make a page of hundreds of megabytes).
 constexpr std::size_t kReportPictureBytes = 24u << 20;
 
+/// What the page shows of partition.json, made from the same values rather
+/// than read back (16 MB of JSON at 100,100 scans).
+nlohmann::json reportRecord(const Partition& of_every_frame, const io::RunRecord& run) {
+  return {{"input", run.input},
+          {"observations", of_every_frame.group_of.size()},
+          {"groups", of_every_frame.groups},
+          {"place_ids", run.place_ids},
+          {"stamps", run.stamps.empty() ? nlohmann::json() : nlohmann::json(run.stamps)},
+          {"parameters", run.parameters},
+          {"statistics", run.statistics},
+          {"timing_s", run.timing_s},
+          {"warnings", run.warnings}};
+}
+
 template <typename PointT>
-void writeReport(const PartitionArgs& args, const io::OutputFolder& out, const std::string& partition_json,
-                 const GroupingOutcome<PointT>& grouped, const std::vector<Observation<PointT>>& observations,
-                 const MapsOfRun<PointT>& maps) {
+void writeReport(const PartitionArgs& args, const io::OutputFolder& out, const Partition& of_every_frame,
+                 const io::RunRecord& run, const OutputTimes& written, const GroupingOutcome<PointT>& grouped,
+                 const std::vector<Observation<PointT>>& observations, const MapsOfRun<PointT>& maps) {
   ReportInput report;
-  report.partition = nlohmann::json::parse(partition_json);
-  if (std::ifstream places(out.path("places.json")); places) report.places = nlohmann::json::parse(places);
+  report.partition = reportRecord(of_every_frame, run);
+  report.places = written.place_outlines;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Eigen::Vector3d t = observations[i].pose.translation();
     report.positions.push_back({t.x(), t.y(), grouped.partition.group_of[i]});
@@ -748,7 +766,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   }
   const std::string partition_json = io::partitionJson(of_every_frame, run);
   out.writeText("partition.json", partition_json);
-  writeReport(args, out, partition_json, grouped, observations, maps);
+  writeReport(args, out, of_every_frame, run, written, grouped, observations, maps);
   out.commit();
   if (!args.quiet) (args.stream ? printStreamSummary : printSummary)(args, run, of_every_frame.group_of.size());
   return 0;

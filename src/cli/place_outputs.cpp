@@ -52,29 +52,42 @@ std::string linesOf(const char* key, const std::vector<nlohmann::json>& items, b
   return out + (last ? "\n" : ",\n");
 }
 
+nlohmann::json placeJson(const Place& p, bool with_members) {
+  nlohmann::json outline = nlohmann::json::array();
+  for (const auto& ring : p.outline) outline.push_back(ringJson(ring, false));
+  nlohmann::json place = {{"id", p.id},
+                          {"area_m2", p.area_m2},
+                          {"centroid", p.area_m2 > 0 ? xy(p.centroid) : nlohmann::json()},
+                          {"label_point", p.area_m2 > 0 ? xy(p.label_point) : nlohmann::json()},
+                          {"bbox", bboxJson(p.bbox)},
+                          {"neighbours", p.neighbours},
+                          {"outline", std::move(outline)}};
+  if (with_members) place["members"] = p.members;
+  return place;
+}
+
+nlohmann::json doorJson(const Door& d) {
+  return {{"places", {d.place_a, d.place_b}},
+          {"midpoint", xy(d.midpoint)},
+          {"width_m", d.width_m},
+          {"segment", {xy(d.end_a), xy(d.end_b)}}};
+}
+
 }  // namespace
 
 std::string placesJson(const PlaceMap& map) {
   std::vector<nlohmann::json> places, doors;
-  for (const Place& p : map.places) {
-    nlohmann::json outline = nlohmann::json::array();
-    for (const auto& ring : p.outline) outline.push_back(ringJson(ring, false));
-    places.push_back({{"id", p.id},
-                      {"members", p.members},
-                      {"area_m2", p.area_m2},
-                      {"centroid", p.area_m2 > 0 ? xy(p.centroid) : nlohmann::json()},
-                      {"label_point", p.area_m2 > 0 ? xy(p.label_point) : nlohmann::json()},
-                      {"bbox", bboxJson(p.bbox)},
-                      {"neighbours", p.neighbours},
-                      {"outline", outline}});
-  }
-  for (const Door& d : map.doors)
-    doors.push_back({{"places", {d.place_a, d.place_b}},
-                     {"midpoint", xy(d.midpoint)},
-                     {"width_m", d.width_m},
-                     {"segment", {xy(d.end_a), xy(d.end_b)}}});
+  for (const Place& p : map.places) places.push_back(placeJson(p, true));
+  for (const Door& d : map.doors) doors.push_back(doorJson(d));
   return "{\n" + linesOf("places", places, false) + linesOf("doors", doors, false) +
          "  \"grid\": " + gridJson(map).dump() + "\n}\n";
+}
+
+nlohmann::json placeOutlinesJson(const PlaceMap& map) {
+  nlohmann::json places = nlohmann::json::array(), doors = nlohmann::json::array();
+  for (const Place& p : map.places) places.push_back(placeJson(p, false));
+  for (const Door& d : map.doors) doors.push_back(doorJson(d));
+  return {{"places", std::move(places)}, {"doors", std::move(doors)}};
 }
 
 std::string placesGeoJson(const PlaceMap& map) {

@@ -6,6 +6,8 @@
 
 #include <obsgroup/places/place_map.h>
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace obsgroup::io {
@@ -14,6 +16,9 @@ namespace obsgroup::io {
 /// "neighbours"}], "doors": [{"places", "midpoint", "width_m", "segment"}],
 /// "grid": {...}}: coordinates in the map's frame, metres.
 std::string placesJson(const PlaceMap& map);
+/// What report.html shows of the places: {"places": [...], "doors": [...]},
+/// each place as in placesJson without its members (the groups hold them).
+nlohmann::json placeOutlinesJson(const PlaceMap& map);
 /// The same outlines (MultiPolygon) and doors (LineString) as a GeoJSON
 /// FeatureCollection, the ids as properties; x, y in the map's frame, metres.
 std::string placesGeoJson(const PlaceMap& map);

@@ -293,13 +293,7 @@ std::string reportHtml(const ReportInput& input) {
                          {"colours", input.colours},
                          {"pictures", input.pictures}};
   if (input.places.is_object()) {
-    nlohmann::json places = nlohmann::json::array();
-    for (const auto& place : input.places.at("places")) {  // members: the groups already hold them
-      nlohmann::json p = place;
-      p.erase("members");
-      places.push_back(std::move(p));
-    }
-    data["places"] = std::move(places);
+    data["places"] = input.places.at("places");
     data["doors"] = input.places.at("doors");
   } else {
     data["places"] = nullptr;

@@ -13,9 +13,13 @@
 namespace obsgroup::cli {
 
 struct ReportInput {
-  /// partition.json as written (its groups are every frame's, with keyframes).
+  /// What partition.json records of the run (its groups are every frame's,
+  /// with keyframes): input, observations, groups, place_ids, stamps,
+  /// parameters, statistics, timing_s and warnings.
   nlohmann::json partition;
-  /// places.json as written; null when the places could not be made.
+  /// The places' outlines and doors (io::placeOutlinesJson: places.json
+  /// without the members, which the groups hold); null when the places
+  /// could not be made.
   nlohmann::json places;
   /// Each grouped observation: x, y of its pose and its group (group order).
   struct Position {
