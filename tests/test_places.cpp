@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include <atomic>
+#include <future>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -309,6 +310,73 @@ TEST(Places, TheSamePlacesForAnyThreadCount) {
           EXPECT_EQ(maps[m].doors[k].midpoint, maps[0].doors[k].midpoint);
       }
     }
+  }
+}
+
+/// The places' pass over every beam (observeFloor), made from the regions
+/// on another thread while the grouping partitions (its regions callback,
+/// as `obsgroup partition` does), gives the same places as buildPlaceMap in
+/// one go, with one thread or three; evidence of another band or of other
+/// regions is refused, and an interrupt stops the pass.
+TEST(Places, FloorEvidenceMadeWhileTheGroupingPartitionsGivesTheSamePlaces) {
+  for (const bool three_d : {false, true}) {
+    const sim::Building office = sim::makeBuilding("office");
+    std::vector<sim::Pose2D> route;
+    for (std::size_t k = 0; k < office.route.size(); k += 3) route.push_back(office.route[k]);
+    const auto observations = three_d ? test::simulate3D<pcl::PointXYZ>(office.plan, route, {-0.5f, 0.0f, 0.5f, 1.5f})
+                                      : test::simulate<pcl::PointXYZ>(office.plan, route, sim::laser360());
+    ObservationGrouping<pcl::PointXYZ> grouping;
+    grouping.setKeepRegions(true);
+    for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+    const auto sso = grouping.getSensedSpaceOverlap();
+    const Eigen::Vector3d origin = SensedSpaceOverlap<pcl::PointXYZ>::worldOrigin(observations);
+    std::vector<Eigen::Vector3d> sensors;
+    for (const auto& o : observations) sensors.push_back(o.pose.translation() - origin);
+    const PlacePointSource points_of = [&](int i, std::vector<Eigen::Vector3f>& scratch) {
+      scratch = sso.observationToWorld(observations[std::size_t(i)], origin);
+      return std::make_pair(scratch.data(), scratch.data() + scratch.size());
+    };
+    int calls = 0;
+    const ObservationRegions* seen_regions = nullptr;
+    std::future<FloorEvidence> pending;
+    grouping.setRegionsCallback([&](const ObservationRegions& regions) {
+      ++calls;
+      seen_regions = &regions;
+      pending = std::async(std::launch::async, [&] { return observeFloor(regions, origin, points_of, sensors, {}, 1); });
+    });
+    const Partition partition = grouping.compute();
+    ASSERT_EQ(calls, 1);
+    ASSERT_EQ(seen_regions, &grouping.getRegions());  // the regions it keeps, not a copy
+    const FloorEvidence floor = pending.get();
+    const ObservationRegions& regions = grouping.getRegions();
+    std::vector<int> ids(partition.groups.size());
+    std::iota(ids.begin(), ids.end(), 3);
+    const PlaceMap whole = buildPlaceMap(regions, sso.toWorld(observations), sensors, partition.groups, ids);
+    const PlaceMap from_floor = buildPlaceMap(regions, floor, sensors, partition.groups, ids);
+    ASSERT_GT(whole.places.size(), 1u);
+    EXPECT_EQ(from_floor.grid.origin, whole.grid.origin);
+    EXPECT_EQ(from_floor.labels, whole.labels) << "3D: " << three_d;
+    EXPECT_EQ(from_floor.occupancy, whole.occupancy) << "3D: " << three_d;
+    ASSERT_EQ(from_floor.places.size(), whole.places.size());
+    for (std::size_t k = 0; k < whole.places.size(); ++k)
+      EXPECT_EQ(from_floor.places[k].outline, whole.places[k].outline);
+    ASSERT_EQ(from_floor.doors.size(), whole.doors.size());
+    EXPECT_EQ(observeFloor(regions, origin, points_of, sensors, {}, 3).seen, floor.seen);
+
+    PlaceOptions other_band;
+    other_band.band_high = 1.2;
+    EXPECT_THROW(buildPlaceMap(regions, floor, sensors, partition.groups, ids, other_band), std::invalid_argument);
+    ObservationRegions fewer;  // the first half of the observations: another grid
+    fewer.planar = regions.planar;
+    fewer.cell_size = regions.cell_size;
+    fewer.phase = regions.phase;
+    for (int i = 0; i < regions.size() / 2; ++i) fewer.append(regions.cellsOf(i));
+    const std::vector<Eigen::Vector3d> fewer_sensors(sensors.begin(), sensors.begin() + fewer.size());
+    std::vector<std::vector<int>> one_group(1);
+    for (int i = 0; i < fewer.size(); ++i) one_group[0].push_back(i);
+    EXPECT_THROW(buildPlaceMap(fewer, floor, fewer_sensors, one_group, {0}), std::invalid_argument);
+    InterruptFlag stop{true};
+    EXPECT_THROW(observeFloor(regions, origin, points_of, sensors, {}, 2, &stop), Interrupted);
   }
 }
 

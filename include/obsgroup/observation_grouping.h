@@ -9,6 +9,7 @@
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -166,6 +167,14 @@ class ObservationGrouping {
   /// The regions kept by the last compute() (empty unless setKeepRegions(true)
   /// and a region model).
   const ObservationRegions& getRegions() const { return regions_; }
+  /// Called by compute() with the regions it keeps (setKeepRegions; empty for
+  /// the points model) once the overlap is measured, before W and the
+  /// partition: a caller can start work that needs the regions alone on a
+  /// thread of its own while the partition runs (the places' pass over every
+  /// beam, observeFloor). They stay as they are until the next compute() or
+  /// clear(). What the callback throws leaves compute().
+  using RegionsCallback = std::function<void(const ObservationRegions& regions)>;
+  void setRegionsCallback(RegionsCallback callback) { regions_callback_ = std::move(callback); }
   /// Time spent in each stage of the last compute().
   const GroupingTimings& getTimings() const { return timings_; }
   /// What the user should know about the last compute(), deterministic and
@@ -186,6 +195,7 @@ class ObservationGrouping {
   WorldPoints world_;
   bool keep_regions_ = false;
   ObservationRegions regions_;
+  RegionsCallback regions_callback_;
   GroupingTimings timings_;
   std::vector<std::string> warnings_;
 };

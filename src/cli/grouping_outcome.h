@@ -4,10 +4,12 @@
 // `stream` (OnlineGrouping, one update per insert) share them.
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/places/place_map.h>
 
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <future>
 #include <vector>
 
 namespace obsgroup::cli {
@@ -36,6 +38,12 @@ struct GroupingOutcome {
   nlohmann::json timing_s = nlohmann::json::object();
   /// What partition.json records of the mode besides the method's parameters.
   nlohmann::json parameters = nlohmann::json::object();
+
+  /// The places' pass over every beam (observeFloor), made on a thread of
+  /// its own while a batch run partitions; not valid otherwise. Last, so
+  /// that it is destroyed, waiting for the pass, before `grouping`, whose
+  /// regions it reads.
+  std::future<FloorEvidence> floor;
 
   const WorldPoints& world() const { return world_points; }
   const WeightMatrix& weights() const { return online ? W : grouping.getWeightMatrix(); }

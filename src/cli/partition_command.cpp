@@ -171,12 +171,43 @@ void configureGrouping(const PartitionArgs& args, ObservationGrouping<PointT>& g
   grouping.setKeepOverlapMatrix(false);  // W is all the rest needs
 }
 
+/// The places' options of the run.
+PlaceOptions placeOptions(const PartitionArgs& args) {
+  PlaceOptions options;
+  options.band_low = args.method.regions.band_low;
+  options.band_high = args.method.regions.band_high;
+  return options;
+}
+
+/// Observation i's points in the common frame, made when the places ask.
+template <typename PointT>
+PlacePointSource pointsOnDemand(const SensedSpaceOverlap<PointT>& sso,
+                                const std::vector<Observation<PointT>>& observations,
+                                const Eigen::Vector3d& origin) {
+  return [&sso, &observations, origin](int i, std::vector<Eigen::Vector3f>& scratch) {
+    scratch = sso.observationToWorld(observations[std::size_t(i)], origin);
+    return std::make_pair(scratch.data(), scratch.data() + scratch.size());
+  };
+}
+
 /// Groups the observations at once: the overlap, W and the partition (sec. II-III).
 template <typename PointT>
 void groupObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
                        const InputRecord& input, GroupingOutcome<PointT>& out) {
   ObservationGrouping<PointT>& grouping = out.grouping;
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  // The places' pass over every beam needs the regions alone: it runs on a
+  // thread of its own while the partition, whose first levels keep one core
+  // busy, is computed.
+  grouping.setRegionsCallback([&args, &observations, &out](const ObservationRegions& regions) {
+    if (regions.size() != int(observations.size())) return;  // the points model: the places compute their own
+    out.floor = std::async(std::launch::async, [&args, &observations, &regions,
+                                                sso = out.grouping.getSensedSpaceOverlap()] {
+      const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
+      return observeFloor(regions, origin, pointsOnDemand(sso, observations, origin),
+                          sensorOrigins(observations, origin), placeOptions(args), 1, args.interrupt);
+    });
+  });
   ProgressBar bar("overlap", !args.quiet, args.progress);
   grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   try {
@@ -403,22 +434,21 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   if (!regions_kept) computed = regionsOfRun(args, grouped, observations);
   const ObservationRegions& regions = regions_kept ? kept : computed;
   bar(1, 2);
-  PlaceOptions place_options;
-  place_options.band_low = args.method.regions.band_low;
-  place_options.band_high = args.method.regions.band_high;
+  const PlaceOptions place_options = placeOptions(args);
   std::optional<PlaceMap> places;
   try {
-    if (grouped.world_points.size() == int(observations.size())) {
+    if (grouped.floor.valid()) {  // the pass over the beams, made while the partition ran
+      const FloorEvidence floor = grouped.floor.get();
+      places = buildPlaceMap(regions, floor, sensorOrigins(observations, SensedSpaceOverlap<PointT>::worldOrigin(observations)),
+                             grouped.partition.groups, grouped.place_ids, place_options);
+    } else if (grouped.world_points.size() == int(observations.size())) {
       places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
                              grouped.partition.groups, grouped.place_ids, place_options);
     } else {
       const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
-      const PlacePointSource points_of = [&](int i, std::vector<Eigen::Vector3f>& scratch) {
-        scratch = sso.observationToWorld(observations[std::size_t(i)], origin);
-        return std::make_pair(scratch.data(), scratch.data() + scratch.size());
-      };
-      places = buildPlaceMap(regions, origin, points_of, sensorOrigins(observations, origin),
-                             grouped.partition.groups, grouped.place_ids, place_options);
+      places = buildPlaceMap(regions, origin, pointsOnDemand(sso, observations, origin),
+                             sensorOrigins(observations, origin), grouped.partition.groups, grouped.place_ids,
+                             place_options);
     }
   } catch (const std::invalid_argument& e) {
     // The groups and local maps stand without them.

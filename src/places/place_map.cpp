@@ -143,10 +143,11 @@ void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::
 /// (isPlanarData). Rethrows what points_of throws.
 std::vector<std::uint8_t> seenCells(const GridFrame& f, const PlacePointSource& points_of,
                                     const std::vector<Eigen::Vector3d>& sensors, double cell_size,
-                                    const PlaceOptions& options, bool& planar) {
+                                    const PlaceOptions& options, bool& planar, int threads_asked,
+                                    const InterruptFlag* interrupt) {
   const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
   const int n = int(sensors.size());
-  const int threads = std::max(1, std::min({omp_get_max_threads(), n, int(kMaxCopiedBytes / std::max<std::size_t>(cells, 1))}));
+  const int threads = std::max(1, std::min({threadCount(threads_asked), n, int(kMaxCopiedBytes / std::max<std::size_t>(cells, 1))}));
   std::list<std::vector<std::uint8_t>> seen;  // one per thread; a list, so that each stays where it was made
   std::mutex seen_mutex;
   struct Scratch {
@@ -163,6 +164,7 @@ std::vector<std::uint8_t> seenCells(const GridFrame& f, const PlacePointSource& 
         return Scratch{&seen.back(), {}};
       },
       [&](std::size_t i, Scratch& s) {
+        throwIfInterrupted(interrupt);
         const auto [begin, end] = points_of(int(i), s.points);
         const region_cells::PointSpan span{begin, end};
         flat[i] = region_cells::observationPlanar(span, sensors[i], z0, 0.25 * cell_size);
@@ -679,39 +681,97 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const WorldPoints& wor
   return buildPlaceMap(regions, world.origin, points_of, sensor_origins, groups, place_ids, options);
 }
 
-PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
-                       const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
-                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
-                       const PlaceOptions& options) {
-  const int n = regions.size();
+namespace {
+
+/// Throws std::invalid_argument, as buildPlaceMap documents, unless every
+/// observation is in exactly one group and the options are in range.
+void checkPlaceInputs(int n, const std::vector<Eigen::Vector3d>& sensor_origins,
+                      const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                      const PlaceOptions& options) {
   if (int(sensor_origins.size()) != n)
     throw std::invalid_argument("buildPlaceMap: regions and sensor origins of " + std::to_string(n) + " and " +
                                 std::to_string(sensor_origins.size()) + " observations");
   if (place_ids.size() != groups.size())
     throw std::invalid_argument("buildPlaceMap: one place id per group expected");
-  std::vector<int> group_of(n, kNone);
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    for (int i : groups[g]) {
-      if (i < 0 || i >= n || group_of[i] != kNone)
+  std::vector<char> grouped(std::size_t(n), 0);
+  for (const auto& group : groups)
+    for (int i : group) {
+      if (i < 0 || i >= n || grouped[std::size_t(i)])
         throw std::invalid_argument("buildPlaceMap: observation " + std::to_string(i) +
                                     " is out of range or in two groups");
-      group_of[i] = int(g);
+      grouped[std::size_t(i)] = 1;
     }
-  if (std::find(group_of.begin(), group_of.end(), kNone) != group_of.end())
+  if (std::find(grouped.begin(), grouped.end(), 0) != grouped.end())
     throw std::invalid_argument("buildPlaceMap: every observation must be in a group");
-
-  PlaceMap map;
   if (!(std::isfinite(options.max_door_width) && options.max_door_width >= 0) ||
       !(std::isfinite(options.min_piece_area) && options.min_piece_area >= 0) ||
       !(std::isfinite(options.band_low) && std::isfinite(options.band_high) && options.band_low < options.band_high))
     throw std::invalid_argument("buildPlaceMap: the door width and piece area must be finite and >= 0, the band "
                                 "finite with low < high");
+}
+
+PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, const std::vector<std::uint8_t>& seen,
+                    bool planar, const std::vector<Eigen::Vector3d>& sensor_origins,
+                    const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                    const PlaceOptions& options);
+
+}  // namespace
+
+FloorEvidence observeFloor(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
+                           const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
+                           const PlaceOptions& options, int threads, const InterruptFlag* interrupt) {
+  if (int(sensor_origins.size()) != regions.size())
+    throw std::invalid_argument("buildPlaceMap: regions and sensor origins of " + std::to_string(regions.size()) +
+                                " and " + std::to_string(sensor_origins.size()) + " observations");
+  if (!(std::isfinite(options.band_low) && std::isfinite(options.band_high) && options.band_low < options.band_high))
+    throw std::invalid_argument("buildPlaceMap: the band must be finite with low < high");
   const GridFrame f = makeGrid(regions, world_origin);
+  FloorEvidence floor;
+  floor.grid = f.grid;
+  floor.band_low = options.band_low;
+  floor.band_high = options.band_high;
+  floor.seen = seenCells(f, points_of, sensor_origins, regions.cell_size, options, floor.planar, threads, interrupt);
+  return floor;
+}
+
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
+                       const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options) {
+  checkPlaceInputs(regions.size(), sensor_origins, groups, place_ids, options);  // before the pass over the beams
+  const FloorEvidence floor = observeFloor(regions, world_origin, points_of, sensor_origins, options);
+  return buildPlaceMap(regions, floor, sensor_origins, groups, place_ids, options);
+}
+
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const FloorEvidence& floor,
+                       const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options) {
+  checkPlaceInputs(regions.size(), sensor_origins, groups, place_ids, options);
+  // The grid's cells are the regions' wherever the world origin lies: only
+  // its origin in the world frame comes from the evidence.
+  GridFrame f = makeGrid(regions, Eigen::Vector3d::Zero());
+  const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
+  if (floor.grid.width != f.grid.width || floor.grid.height != f.grid.height ||
+      floor.grid.resolution != f.grid.resolution || floor.seen.size() != cells)
+    throw std::invalid_argument("buildPlaceMap: the floor evidence is of another grid than these regions'");
+  if (floor.band_low != options.band_low || floor.band_high != options.band_high)
+    throw std::invalid_argument("buildPlaceMap: the floor evidence was marked with another band");
+  f.grid.origin = floor.grid.origin;
+  return placesFrom(regions, f, floor.seen, floor.planar, sensor_origins, groups, place_ids, options);
+}
+
+namespace {
+
+PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, const std::vector<std::uint8_t>& seen,
+                    bool planar, const std::vector<Eigen::Vector3d>& sensor_origins,
+                    const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                    const PlaceOptions& options) {
+  const int n = regions.size();
+  PlaceMap map;
   const FloorGrid& g = f.grid;
   map.grid = g;
   const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
-  bool planar = true;
-  const std::vector<std::uint8_t> seen = seenCells(f, points_of, sensor_origins, regions.cell_size, options, planar);
   // Floor is what a beam crossed and a region holds: a region model may
   // reach where no beam went (visibility all around a forward sensor).
   const FloorCellOfKey cell_of(regions, f);
@@ -781,5 +841,7 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d&
     if (label[c] != kNone) map.labels[c] = place_ids[label[c]];
   return map;
 }
+
+}  // namespace
 
 }  // namespace obsgroup

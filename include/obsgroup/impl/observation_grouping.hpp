@@ -61,6 +61,7 @@ Partition ObservationGrouping<PointT>::compute() {
     overlap_result_ = overlap.compute(observations_);
   }
   timings_.overlap_s = seconds_since(start);
+  if (keep_regions_ && regions_callback_) regions_callback_(regions_);
   start = Clock::now();
   W_ = buildWeightMatrix(static_cast<int>(observations_.size()), overlap_result_.pairs, params_.diagonal_weight);
   if (!keep_overlap_matrix_) {

@@ -6,6 +6,7 @@
 /// place holds this pose". Built from the sensed regions the grouping
 /// measured (sensed_regions.h); no PCL.
 
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/overlap/sensed_regions.h"
 #include "obsgroup/overlap/world_points.h"
 
@@ -146,6 +147,38 @@ using PlacePointSource = std::function<std::pair<const Eigen::Vector3f*, const E
 /// The same places as from the WorldPoints holding the same points.
 PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
                        const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
+                       const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
+                       const PlaceOptions& options = {});
+
+/// What the observations' beams say of the places' grid, whatever the
+/// groups: the first half of buildPlaceMap (a pass over every beam), which
+/// needs the regions and the points alone, so that a caller can make it
+/// while the partition is computed. Made by observeFloor, read by
+/// buildPlaceMap with the same regions and band.
+struct FloorEvidence {
+  FloorGrid grid;  ///< the places' grid: the regions' cells and one cell around them
+  /// Per cell of `grid`: 1 a beam crossed it, 2 a point lies in it, 4 a
+  /// point within the band lies in it (bits, or-ed).
+  std::vector<std::uint8_t> seen;
+  bool planar = true;  ///< every point and sensor at the first sensor's height (2D data)
+  double band_low = 0.0, band_high = 0.0;  ///< the PlaceOptions band the bits were marked with
+};
+
+/// The beams' evidence of the places' grid, on `threads` threads (0:
+/// OpenMP's default; the same bits for any count). Polls `interrupt` between
+/// observations and throws Interrupted when it is set. Throws
+/// std::invalid_argument as buildPlaceMap does, and rethrows what points_of
+/// throws.
+FloorEvidence observeFloor(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
+                           const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
+                           const PlaceOptions& options = {}, int threads = 0,
+                           const InterruptFlag* interrupt = nullptr);
+
+/// buildPlaceMap from the beams' evidence observeFloor made of the same
+/// regions (and band): the same places as the overloads above. Throws
+/// std::invalid_argument when the evidence is of another grid or band.
+PlaceMap buildPlaceMap(const ObservationRegions& regions, const FloorEvidence& floor,
+                       const std::vector<Eigen::Vector3d>& sensor_origins,
                        const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
                        const PlaceOptions& options = {});
 
