@@ -198,8 +198,8 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
   // The places' pass over every beam needs the regions alone: it runs on a
   // thread of its own while the partition, whose first levels keep one core
-  // busy, is computed.
-  grouping.setRegionsCallback([&args, &observations, &out](const ObservationRegions& regions) {
+  // busy, is computed; with one thread asked for, after it.
+  const auto observeFloorNow = [&args, &observations, &out](const ObservationRegions& regions) {
     if (regions.size() != int(observations.size())) return;  // the points model: the places compute their own
     out.floor = std::async(std::launch::async, [&args, &observations, &regions,
                                                 sso = out.grouping.getSensedSpaceOverlap()] {
@@ -207,7 +207,8 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
       return observeFloor(regions, origin, pointsOnDemand(sso, observations, origin),
                           sensorOrigins(observations, origin), placeOptions(args), 1, args.interrupt);
     });
-  });
+  };
+  if (threadCount(args.method.threads) > 1) grouping.setRegionsCallback(observeFloorNow);
   ProgressBar bar("overlap", !args.quiet, args.progress);
   grouping.setProgressCallback([&bar](std::size_t done, std::size_t total) { bar(done, total); });
   try {
