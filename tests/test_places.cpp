@@ -361,7 +361,8 @@ TEST(Places, FloorEvidenceMadeWhileTheGroupingPartitionsGivesTheSamePlaces) {
     for (std::size_t k = 0; k < whole.places.size(); ++k)
       EXPECT_EQ(from_floor.places[k].outline, whole.places[k].outline);
     ASSERT_EQ(from_floor.doors.size(), whole.doors.size());
-    EXPECT_EQ(observeFloor(regions, origin, points_of, sensors, {}, 3).seen, floor.seen);
+    EXPECT_EQ(observeFloor(regions, origin, points_of, sensors, {}, 3).occupancy, floor.occupancy);
+    EXPECT_EQ(floor.occupancy, whole.occupancy);
 
     PlaceOptions other_band;
     other_band.band_high = 1.2;

@@ -710,10 +710,9 @@ void checkPlaceInputs(int n, const std::vector<Eigen::Vector3d>& sensor_origins,
                                 "finite with low < high");
 }
 
-PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, const std::vector<std::uint8_t>& seen,
-                    bool planar, const std::vector<Eigen::Vector3d>& sensor_origins,
-                    const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
-                    const PlaceOptions& options);
+PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, std::vector<Occupancy> occupancy,
+                    const std::vector<Eigen::Vector3d>& sensor_origins, const std::vector<std::vector<int>>& groups,
+                    const std::vector<int>& place_ids, const PlaceOptions& options);
 
 }  // namespace
 
@@ -730,7 +729,22 @@ FloorEvidence observeFloor(const ObservationRegions& regions, const Eigen::Vecto
   floor.grid = f.grid;
   floor.band_low = options.band_low;
   floor.band_high = options.band_high;
-  floor.seen = seenCells(f, points_of, sensor_origins, regions.cell_size, options, floor.planar, threads, interrupt);
+  bool planar = true;
+  const std::vector<std::uint8_t> seen =
+      seenCells(f, points_of, sensor_origins, regions.cell_size, options, planar, threads, interrupt);
+  // Floor is what a beam crossed and a region holds: a region model may
+  // reach where no beam went (visibility all around a forward sensor).
+  const FloorCellOfKey cell_of(regions, f);
+  const std::size_t cells = seen.size();
+  floor.occupancy.assign(cells, Occupancy::Unknown);
+  for (int i = 0; i < regions.size(); ++i)
+    regions.forEachCell(i, [&](std::uint64_t key) {
+      if (const std::size_t k = cell_of(key); seen[k] & kCrossed) floor.occupancy[k] = Occupancy::Free;
+    });
+  // Planar data is all obstacle; in 3D, the points within the band above the floor.
+  const std::uint8_t obstacle = planar ? kPoint : kPointInBand;
+  for (std::size_t k = 0; k < cells; ++k)
+    if (seen[k] & obstacle) floor.occupancy[k] = Occupancy::Occupied;
   return floor;
 }
 
@@ -753,37 +767,25 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const FloorEvidence& f
   GridFrame f = makeGrid(regions, Eigen::Vector3d::Zero());
   const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
   if (floor.grid.width != f.grid.width || floor.grid.height != f.grid.height ||
-      floor.grid.resolution != f.grid.resolution || floor.seen.size() != cells)
+      floor.grid.resolution != f.grid.resolution || floor.occupancy.size() != cells)
     throw std::invalid_argument("buildPlaceMap: the floor evidence is of another grid than these regions'");
   if (floor.band_low != options.band_low || floor.band_high != options.band_high)
     throw std::invalid_argument("buildPlaceMap: the floor evidence was marked with another band");
   f.grid.origin = floor.grid.origin;
-  return placesFrom(regions, f, floor.seen, floor.planar, sensor_origins, groups, place_ids, options);
+  return placesFrom(regions, f, floor.occupancy, sensor_origins, groups, place_ids, options);
 }
 
 namespace {
 
-PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, const std::vector<std::uint8_t>& seen,
-                    bool planar, const std::vector<Eigen::Vector3d>& sensor_origins,
-                    const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
-                    const PlaceOptions& options) {
-  const int n = regions.size();
+PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, std::vector<Occupancy> occupancy,
+                    const std::vector<Eigen::Vector3d>& sensor_origins, const std::vector<std::vector<int>>& groups,
+                    const std::vector<int>& place_ids, const PlaceOptions& options) {
   PlaceMap map;
   const FloorGrid& g = f.grid;
   map.grid = g;
   const std::size_t cells = std::size_t(g.width) * std::size_t(g.height);
-  // Floor is what a beam crossed and a region holds: a region model may
-  // reach where no beam went (visibility all around a forward sensor).
   const FloorCellOfKey cell_of(regions, f);
-  map.occupancy.assign(cells, Occupancy::Unknown);
-  for (int i = 0; i < n; ++i)
-    regions.forEachCell(i, [&](std::uint64_t key) {
-      if (const std::size_t k = cell_of(key); seen[k] & kCrossed) map.occupancy[k] = Occupancy::Free;
-    });
-  // Planar data is all obstacle; in 3D, the points within the band above the floor.
-  const std::uint8_t obstacle = planar ? kPoint : kPointInBand;
-  for (std::size_t k = 0; k < cells; ++k)
-    if (seen[k] & obstacle) map.occupancy[k] = Occupancy::Occupied;
+  map.occupancy = std::move(occupancy);
 
   std::vector<int> label = cells ? openedLabels(g, ownerOfCells(regions, cell_of, groups, map.occupancy)) : std::vector<int>{};
   const double cell_area = g.resolution * g.resolution;
@@ -824,14 +826,21 @@ PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, const
     for (auto t = first; t != touches.end() && t->first == int(k); ++t) place.neighbours.push_back(place_ids[t->second]);
     std::sort(place.neighbours.begin(), place.neighbours.end());
   }
-  for (std::size_t p = 0; p < pieces.cells.size(); ++p) {
-    Place& place = map.places[pieces.label[p]];
+  // Each piece's rings on any thread, then added to their places in piece
+  // order: the same outlines for any thread count.
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> rings_of(pieces.cells.size());
+  parallelFor(pieces.cells.size(), 0, 16, [&](std::size_t p) {
     for (const auto& ring : traceRings(g, label, pieces.cells[p])) {
       std::vector<Eigen::Vector2d> points;
-      for (const Vertex& v : withoutStraightCorners(ring)) {
+      for (const Vertex& v : withoutStraightCorners(ring))
         points.push_back(g.origin + g.resolution * Eigen::Vector2d(v.first, v.second));
-        place.bbox.extend(points.back());
-      }
+      rings_of[p].push_back(std::move(points));
+    }
+  });
+  for (std::size_t p = 0; p < pieces.cells.size(); ++p) {
+    Place& place = map.places[pieces.label[p]];
+    for (auto& points : rings_of[p]) {
+      for (const Eigen::Vector2d& point : points) place.bbox.extend(point);
       place.outline.push_back(std::move(points));
     }
   }

@@ -157,11 +157,11 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const Eigen::Vector3d&
 /// buildPlaceMap with the same regions and band.
 struct FloorEvidence {
   FloorGrid grid;  ///< the places' grid: the regions' cells and one cell around them
-  /// Per cell of `grid`: 1 a beam crossed it, 2 a point lies in it, 4 a
-  /// point within the band lies in it (bits, or-ed).
-  std::vector<std::uint8_t> seen;
-  bool planar = true;  ///< every point and sensor at the first sensor's height (2D data)
-  double band_low = 0.0, band_high = 0.0;  ///< the PlaceOptions band the bits were marked with
+  /// Per cell of `grid`, as PlaceMap::occupancy: free where a region holds
+  /// it and a beam crossed it, occupied where points lie (3D: points within
+  /// the band), unknown elsewhere.
+  std::vector<Occupancy> occupancy;
+  double band_low = 0.0, band_high = 0.0;  ///< the PlaceOptions band the obstacles were found with
 };
 
 /// The beams' evidence of the places' grid, on `threads` threads (0:
