@@ -440,8 +440,9 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   try {
     if (grouped.floor.valid()) {  // the pass over the beams, made while the partition ran
       const FloorEvidence floor = grouped.floor.get();
-      places = buildPlaceMap(regions, floor, sensorOrigins(observations, SensedSpaceOverlap<PointT>::worldOrigin(observations)),
-                             grouped.partition.groups, grouped.place_ids, place_options);
+      const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
+      places = buildPlaceMap(regions, floor, sensorOrigins(observations, origin), grouped.partition.groups,
+                             grouped.place_ids, place_options);
     } else if (grouped.world_points.size() == int(observations.size())) {
       places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
                              grouped.partition.groups, grouped.place_ids, place_options);
