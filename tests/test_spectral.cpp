@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <Eigen/OrderingMethods>
 
 #include <algorithm>
 #include <random>
@@ -176,6 +177,29 @@ TEST(Fiedler, AnyEliminationOrderGivesTheSameVector) {
   FiedlerOptions wrong = withSolver(EigenSolver::Sparse);
   wrong.elimination_rank = {0, 1, 2};
   EXPECT_THROW(fiedlerVector(W, wrong), std::invalid_argument);
+}
+
+TEST(Fiedler, ItsOwnOrderingIsEigensAMDOrdering) {
+  // fiedlerVector orders the grounded Laplacian (all nodes but the last) with
+  // AMD from its pattern alone, without Eigen's AMDOrdering's copies. Handing
+  // it Eigen's AMDOrdering of the same pattern as ranks must give the very
+  // same factor, hence the same bits.
+  for (const WeightMatrix& W : {routeGraph(700, 8, 17), routeGraph(400, 20, 19)}) {
+    const int n = int(W.rows());
+    WeightMatrix identity(n, n);
+    identity.setIdentity();
+    const WeightMatrix pattern = WeightMatrix(W + identity).topLeftCorner(n - 1, n - 1);  // L's pattern
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> amd;
+    Eigen::AMDOrdering<int>()(pattern, amd);
+    FiedlerOptions options = withSolver(EigenSolver::Sparse);
+    options.elimination_rank.assign(std::size_t(n), n - 1);
+    for (int k = 0; k + 1 < n; ++k) options.elimination_rank[std::size_t(amd.indices()[k])] = k;
+    const FiedlerResult own = fiedlerVector(W, withSolver(EigenSolver::Sparse));
+    const FiedlerResult eigens = fiedlerVector(W, options);
+    ASSERT_TRUE(own.sparse && eigens.sparse);
+    EXPECT_EQ(own.eigenvalue, eigens.eigenvalue);
+    EXPECT_EQ(own.y, eigens.y);
+  }
 }
 
 TEST(Fiedler, AUsersEliminationOrderGivesThePartitionOfTheSharedOne) {
