@@ -58,6 +58,7 @@ struct Reuse {
   const std::vector<char>& changed;
   SplitCache::Store& previous;  // a copied decision is moved on to `next` when recorded
   SplitCache::Store& next;
+  std::vector<FiedlerWorkspace>& workspaces;  // kept from one run to the next
 };
 
 }  // namespace
@@ -85,7 +86,8 @@ struct SplitCache::Store {
   }
 };
 
-SplitCache::SplitCache() : store_(std::make_shared<Store>()) {}
+SplitCache::SplitCache()
+    : store_(std::make_shared<Store>()), workspaces_(std::make_shared<std::vector<FiedlerWorkspace>>()) {}
 void SplitCache::clear() { *store_ = Store{}; }
 std::size_t SplitCache::reusedNodes() const { return store_->reused; }
 std::size_t SplitCache::computedNodes() const { return store_->computed; }
@@ -103,10 +105,31 @@ std::vector<int> eliminationRanks(const WeightMatrix& W, const FiedlerOptions& e
   return eigen.elimination_rank;
 }
 
+/// The thread of the innermost OpenMP team running this (0 outside one).
+int threadIndex() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+/// What each thread of a level of the split tree works with.
+struct NodeScratch {
+  std::vector<int> local_of;     // inducedSubgraph's
+  FiedlerWorkspace* workspace;   // this thread's, kept over the levels
+};
+
 class Partitioner {
  public:
   Partitioner(const WeightMatrix& W, const PartitionOptions& options, Reuse* reuse = nullptr)
-      : W_(W), options_(options), rank_(eliminationRanks(W, options.eigen)), reuse_(reuse) {}
+      : W_(W), options_(options), rank_(eliminationRanks(W, options.eigen)), reuse_(reuse),
+        workspaces_(reuse ? reuse->workspaces : own_workspaces_) {
+    // One workspace per thread a level can run on, so that every node's
+    // eigen solve reuses the buffers of the solves before it on its thread.
+    const std::size_t threads = std::size_t(threadCount(options.threads));
+    if (workspaces_.size() < threads) workspaces_.resize(threads);
+  }
 
   Partition run() {
     const int n = static_cast<int>(W_.rows());
@@ -128,10 +151,11 @@ class Partitioner {
       // Each thread has its own scratch for inducedSubgraph; the first failing
       // node's exception is rethrown unchanged (an input error stays one).
       parallelForWithScratch(
-          frontier.size(), options_.threads, 1, [n] { return std::vector<int>(n, -1); },
-          [&](std::size_t k, std::vector<int>& local_of) {
+          frontier.size(), options_.threads, 1,
+          [&] { return NodeScratch{std::vector<int>(n, -1), &workspaces_[std::size_t(threadIndex())]}; },
+          [&](std::size_t k, NodeScratch& scratch) {
             if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k]))
-              decisions[k] = decide(out_.splits[frontier[k]], local_of);
+              decisions[k] = decide(out_.splits[frontier[k]], scratch);
           });
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
@@ -198,7 +222,7 @@ class Partitioner {
     ++reuse_->next.computed;
   }
 
-  Decision decide(const SplitNode& current, std::vector<int>& local_of) const {
+  Decision decide(const SplitNode& current, NodeScratch& scratch) const {
     Decision d;
     const std::vector<int>& members = current.members;
     d.child_depth = current.depth;
@@ -207,7 +231,7 @@ class Partitioner {
     // no copy of the largest matrix of the run.
     WeightMatrix copied;
     const bool whole = Eigen::Index(members.size()) == W_.rows();
-    if (!whole) copied = inducedSubgraph(W_, members, local_of);
+    if (!whole) copied = inducedSubgraph(W_, members, scratch.local_of);
     const WeightMatrix& sub = whole ? W_ : copied;
     if (splitIntoComponents(sub, members, d)) return d;
     const int min_size = std::max(1, options_.min_group_size);
@@ -217,7 +241,7 @@ class Partitioner {
       return d;
     }
     Bisection b;
-    if (!bisect(sub, members, min_size, b, d)) return d;
+    if (!bisect(sub, members, min_size, *scratch.workspace, b, d)) return d;
     judgeBisection(b, members, min_size, current.depth, d);
     return d;
   }
@@ -240,14 +264,14 @@ class Partitioner {
 
   /// The spectral bisection of a connected node (sec. II-A), recorded in the
   /// node; false when no eigenvector could be trusted (the node stays whole).
-  bool bisect(const WeightMatrix& sub, const std::vector<int>& members, int min_size, Bisection& b,
-              Decision& d) const {
+  bool bisect(const WeightMatrix& sub, const std::vector<int>& members, int min_size, FiedlerWorkspace& workspace,
+              Bisection& b, Decision& d) const {
     FiedlerOptions eigen = options_.eigen;
     eigen.elimination_rank.clear();
     if (!rank_.empty())
       for (int i : members) eigen.elimination_rank.push_back(rank_[i]);
     try {
-      b = spectralBisection(sub, options_.split, eigen, min_size);
+      b = spectralBisection(sub, options_.split, eigen, min_size, workspace);
     } catch (const EigenSolverError& e) {
       // A group left whole is a usable, if coarse, answer; an unchecked
       // eigenvector is not.
@@ -307,6 +331,8 @@ class Partitioner {
   const PartitionOptions& options_;
   const std::vector<int> rank_;  // see eliminationRanks
   Reuse* reuse_;
+  std::vector<FiedlerWorkspace> own_workspaces_;  // this run's, unless the cache keeps them
+  std::vector<FiedlerWorkspace>& workspaces_;
   Partition out_;
 };
 
@@ -427,7 +453,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     throw std::invalid_argument("recursivePartition: node ids must ascend");
   checkWeights(W);
   auto next = std::make_shared<SplitCache::Store>();
-  Reuse reuse{ids, changed, *cache.store_, *next};
+  Reuse reuse{ids, changed, *cache.store_, *next, *cache.workspaces_};
   try {
     Partition partition = Partitioner(W, options, &reuse).run();
     cache.store_ = std::move(next);

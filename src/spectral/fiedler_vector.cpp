@@ -16,14 +16,15 @@ namespace obsgroup {
 namespace {
 
 /// Normalized Laplacian of eq. (11): I - D^-1/2 W D^-1/2, written as
-/// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured.
-WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d) {
+/// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured; into
+/// L's storage.
+void normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d, WeightMatrix& L) {
   // D^-1/2 (D - W) D^-1/2 in one pass over W's columns, the diagonal entry
   // inserted in row order. The arithmetic is that of the matrix expression,
   // (s_i * ([i == j] d_i - w_ij)) * s_j, so the results are the same bits.
   const Eigen::Index n = W.outerSize();
   const Eigen::VectorXd diagonal = inv_sqrt_d.cwiseInverse().cwiseAbs2();
-  WeightMatrix L(n, n);
+  L.resize(n, n);
   L.reserve(W.nonZeros() + n);
   for (Eigen::Index j = 0; j < n; ++j) {
     L.startVec(j);
@@ -43,27 +44,25 @@ WeightMatrix normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& i
     if (!diagonal_done) put(j, 0.0);
   }
   L.finalize();
-  return L;
 }
 
 using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
 
 /// A symmetric sparse matrix without its last row and column, copied
-/// straight into storage of its exact size (a block assignment grows its
-/// storage as it goes, a copy and fresh pages at each step).
-WeightMatrix withoutLastNode(const WeightMatrix& A) {
+/// straight into B's storage, reserved at its exact size (a block assignment
+/// grows its storage as it goes, a copy and fresh pages at each step).
+void withoutLastNode(const WeightMatrix& A, WeightMatrix& B) {
   const Eigen::Index m = A.rows() - 1;
   Eigen::Index entries = 0;
   for (Eigen::Index j = 0; j < m; ++j)
     for (WeightMatrix::InnerIterator it(A, j); it && it.row() < m; ++it) ++entries;
-  WeightMatrix B(m, m);
+  B.resize(m, m);
   B.reserve(entries);
   for (Eigen::Index j = 0; j < m; ++j) {
     B.startVec(j);
     for (WeightMatrix::InnerIterator it(A, j); it && it.row() < m; ++it) B.insertBack(it.row(), j) = it.value();
   }
   B.finalize();
-  return B;
 }
 
 /// AMD's order of a compressed matrix whose pattern is symmetric, the same
@@ -72,14 +71,14 @@ WeightMatrix withoutLastNode(const WeightMatrix& A) {
 /// A's own, so one copy of A's indices, with the elbow room the ordering
 /// asks for reserved up front, is enough. At 10,000 scans those two copies
 /// and their fresh pages took a third of an online update's eigen solves.
-Permutation amdOrder(const WeightMatrix& A) {
+Permutation amdOrder(const WeightMatrix& A, Eigen::SparseMatrix<double, Eigen::ColMajor, int>& pattern) {
   Permutation order;
   if (!A.isCompressed()) {
     Eigen::AMDOrdering<int>()(A, order);
     return order;
   }
   const Eigen::Index n = A.cols(), entries = A.nonZeros();
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> pattern(n, n);
+  pattern.resize(n, n);
   pattern.reserve(entries + entries / 5 + 2 * n);  // minimum_degree_ordering's elbow room
   pattern.resizeNonZeros(entries);                 // the values are never read
   std::copy(A.outerIndexPtr(), A.outerIndexPtr() + n + 1, pattern.outerIndexPtr());
@@ -92,8 +91,9 @@ Permutation amdOrder(const WeightMatrix& A) {
 /// orderings give it (entry k: the node eliminated k-th): the nodes by
 /// increasing rank when ranks are given (rank[k] for node k; extra entries
 /// are ignored), else AMD's.
-Permutation eliminationOrder(const WeightMatrix& A, const std::vector<int>& rank) {
-  if (rank.empty()) return amdOrder(A);
+Permutation eliminationOrder(const WeightMatrix& A, const std::vector<int>& rank,
+                             Eigen::SparseMatrix<double, Eigen::ColMajor, int>& pattern) {
+  if (rank.empty()) return amdOrder(A, pattern);
   Permutation order;
   order.resize(A.rows());
   std::iota(order.indices().data(), order.indices().data() + A.rows(), 0);
@@ -115,7 +115,40 @@ class PreorderedLDLT : public Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, 
     analyzePattern_preordered(upper, true);
     factorize_preordered<true>(upper);
   }
+  std::size_t factorBytes() const {
+    return std::size_t(m_matrix.data().allocatedSize()) * (sizeof(double) + sizeof(int));
+  }
 };
+
+}  // namespace
+
+struct FiedlerWorkspace::Buffers {
+  WeightMatrix laplacian, grounded, permuted;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> pattern;
+  PreorderedLDLT ldlt;
+
+  static std::size_t bytesOf(const WeightMatrix& m) {
+    return std::size_t(m.data().allocatedSize()) * (sizeof(double) + sizeof(int)) +
+           std::size_t(m.outerSize() + 1) * sizeof(int);
+  }
+  std::size_t bytes() const {
+    return bytesOf(laplacian) + bytesOf(grounded) + bytesOf(permuted) + bytesOf(pattern) + ldlt.factorBytes();
+  }
+};
+
+FiedlerWorkspace::FiedlerWorkspace() : buffers_(std::make_unique<Buffers>()) {}
+FiedlerWorkspace::~FiedlerWorkspace() = default;
+FiedlerWorkspace::FiedlerWorkspace(FiedlerWorkspace&&) noexcept = default;
+FiedlerWorkspace& FiedlerWorkspace::operator=(FiedlerWorkspace&&) noexcept = default;
+std::size_t FiedlerWorkspace::heldBytes() const { return buffers_ ? buffers_->bytes() : 0; }
+FiedlerWorkspace::Buffers& FiedlerWorkspace::buffers() {
+  if (!buffers_) buffers_ = std::make_unique<Buffers>();
+  return *buffers_;
+}
+
+namespace {
+
+using Buffers = FiedlerWorkspace::Buffers;
 
 /// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
 /// null vector of eq. (11)). Its largest eigenvalue is 1/lambda_1, so Lanczos
@@ -128,12 +161,13 @@ class DeflatedLaplacianInverse {
  public:
   using Scalar = double;
 
-  DeflatedLaplacianInverse(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& rank)
-      : n_(L.rows()), z0_(std::move(z0)) {
-    const WeightMatrix grounded = withoutLastNode(L);
-    order_ = eliminationOrder(grounded, rank);
+  DeflatedLaplacianInverse(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& rank, Buffers& buffers)
+      : n_(L.rows()), z0_(std::move(z0)), ldlt_(buffers.ldlt) {
+    const WeightMatrix& grounded = buffers.grounded;
+    withoutLastNode(L, buffers.grounded);
+    order_ = eliminationOrder(grounded, rank, buffers.pattern);
     to_eliminated_ = order_.inverse();
-    WeightMatrix permuted(n_ - 1, n_ - 1);  // upper triangle, in elimination order
+    WeightMatrix& permuted = buffers.permuted;  // upper triangle, in elimination order
     permuted.selfadjointView<Eigen::Upper>() = grounded.selfadjointView<Eigen::Lower>().twistedBy(to_eliminated_);
     ldlt_.computeInOrder(permuted);
     if (ldlt_.info() != Eigen::Success)
@@ -156,7 +190,7 @@ class DeflatedLaplacianInverse {
   Eigen::Index n_;
   Eigen::VectorXd z0_;
   Permutation order_, to_eliminated_;
-  PreorderedLDLT ldlt_;
+  PreorderedLDLT& ldlt_;
 };
 
 /// Spectra operator for P (I - L) P = P D^-1/2 W D^-1/2 P: its largest
@@ -166,7 +200,8 @@ class DeflatedLaplacianInverse {
 class DeflatedNormalizedAdjacency {
  public:
   using Scalar = double;
-  DeflatedNormalizedAdjacency(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& /*rank*/)
+  DeflatedNormalizedAdjacency(const WeightMatrix& L, Eigen::VectorXd z0, const std::vector<int>& /*rank*/,
+                              Buffers& /*buffers*/)
       : L_(L), z0_(std::move(z0)) {}
   Eigen::Index rows() const { return L_.rows(); }
   Eigen::Index cols() const { return L_.cols(); }
@@ -210,10 +245,10 @@ constexpr double kMaxResidual = 1e-6;
 
 template <typename Operator>
 bool solveSparse(const WeightMatrix& L, const Eigen::VectorXd& z0, const FiedlerOptions& options,
-                 int ncv, Eigen::VectorXd& z, EigenCheck& checked) {
+                 Buffers& buffers, int ncv, Eigen::VectorXd& z, EigenCheck& checked) {
   std::optional<Operator> op;
   try {
-    op.emplace(L, z0, options.elimination_rank);
+    op.emplace(L, z0, options.elimination_rank, buffers);
   } catch (const EigenSolverError&) {
     return false;  // e.g. a factorisation that failed: the next solver takes over
   }
@@ -252,9 +287,26 @@ void fixSign(Eigen::VectorXd& y) {
   }
 }
 
+/// Buffers above this are given back after the solve that needed them: the
+/// root of a run of a million scans would otherwise hold gigabytes while the
+/// rest of the split tree, whose nodes are smaller, is solved.
+constexpr std::size_t kMaxKeptBytes = std::size_t(256) << 20;
+
 }  // namespace
 
 FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options) {
+  FiedlerWorkspace workspace;
+  return fiedlerVector(W, options, workspace);
+}
+
+FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options, FiedlerWorkspace& workspace) {
+  struct GiveBackLarge {
+    FiedlerWorkspace& w;
+    ~GiveBackLarge() {
+      if (w.heldBytes() > kMaxKeptBytes) w = FiedlerWorkspace();
+    }
+  } give_back{workspace};
+  Buffers& buffers = workspace.buffers();
   const Eigen::Index n = W.rows();
   if (n < 2) throw std::invalid_argument("Fiedler vector: the graph needs at least two nodes");
   if (!options.elimination_rank.empty() && Eigen::Index(options.elimination_rank.size()) != n)
@@ -264,7 +316,8 @@ FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options
     throw std::invalid_argument("Fiedler vector: a node has zero degree (split components first)");
 
   const Eigen::VectorXd inv_sqrt_d = d.cwiseSqrt().cwiseInverse();
-  const WeightMatrix L = normalizedLaplacian(W, inv_sqrt_d);
+  WeightMatrix& L = buffers.laplacian;
+  normalizedLaplacian(W, inv_sqrt_d, L);
   const Eigen::VectorXd z0 = d.cwiseSqrt().normalized();  // eq. (11): z0 = D^1/2 1
 
   FiedlerResult result;
@@ -277,9 +330,10 @@ FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options
     const double degree = double(W.nonZeros()) / double(n);
     const bool dense_graph = degree >= kDenseGraphDegree && degree >= kDenseGraphShare * double(n);
     const int wide_ncv = static_cast<int>(std::min<Eigen::Index>(n, 80));
-    result.sparse = (dense_graph && solveSparse<DeflatedNormalizedAdjacency>(L, z0, options, ncv, z, checked)) ||
-                    solveSparse<DeflatedLaplacianInverse>(L, z0, options, ncv, z, checked) ||
-                    solveSparse<DeflatedLaplacianInverse>(L, z0, options, wide_ncv, z, checked);
+    result.sparse =
+        (dense_graph && solveSparse<DeflatedNormalizedAdjacency>(L, z0, options, buffers, ncv, z, checked)) ||
+        solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, ncv, z, checked) ||
+        solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, wide_ncv, z, checked);
     result.fell_back = !result.sparse;
   }
   if (!result.sparse) {

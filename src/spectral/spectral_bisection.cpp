@@ -48,8 +48,14 @@ double bestNcutThreshold(const WeightMatrix& W, const Eigen::VectorXd& y, int mi
 
 Bisection spectralBisection(const WeightMatrix& W, SplitCriterion criterion,
                             const FiedlerOptions& options, int min_side) {
+  FiedlerWorkspace workspace;
+  return spectralBisection(W, criterion, options, min_side, workspace);
+}
+
+Bisection spectralBisection(const WeightMatrix& W, SplitCriterion criterion, const FiedlerOptions& options,
+                            int min_side, FiedlerWorkspace& workspace) {
   Bisection b;
-  b.fiedler = fiedlerVector(W, options);
+  b.fiedler = fiedlerVector(W, options, workspace);
   const Eigen::VectorXd& y = b.fiedler.y;
   switch (criterion) {
     case SplitCriterion::Mean: b.threshold = y.mean(); break;  // the paper's rule, sec. II-A

@@ -122,6 +122,10 @@ class SplitCache {
   friend Partition recursivePartition(const WeightMatrix&, const PartitionOptions&, const std::vector<int>&,
                                       const std::vector<char>&, SplitCache&);
   std::shared_ptr<Store> store_;
+  /// The eigen solves' buffers, one per thread, kept from one run to the
+  /// next: the nodes solved again after an insert are about as large as
+  /// last time's (see FiedlerWorkspace).
+  std::shared_ptr<std::vector<FiedlerWorkspace>> workspaces_;
 };
 
 /// recursivePartition reusing `cache`'s decisions, then leaving this run's in

@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -72,11 +74,38 @@ struct FiedlerResult {
   double residual = 0.0;
 };
 
+/// The buffers of the sparse eigen solve (the normalized Laplacian, the
+/// pattern its fill-reducing order is computed from, the matrix in that order
+/// and its Cholesky factor), kept from one solve to the next. A run of
+/// solves, such as the split tree's nodes or an online update after every
+/// insert, then reuses memory instead of asking the system for fresh pages
+/// at each solve. The result does not depend on it. One per thread: two
+/// solves at once must not share one. Buffers above 256 MB are given back
+/// after the solve that needed them.
+class FiedlerWorkspace {
+ public:
+  FiedlerWorkspace();
+  ~FiedlerWorkspace();
+  FiedlerWorkspace(FiedlerWorkspace&&) noexcept;
+  FiedlerWorkspace& operator=(FiedlerWorkspace&&) noexcept;
+  /// Bytes the buffers hold now.
+  std::size_t heldBytes() const;
+
+  struct Buffers;  ///< opaque
+  Buffers& buffers();
+
+ private:
+  std::unique_ptr<Buffers> buffers_;
+};
+
 /// Fiedler vector of a connected graph with positive degrees (the recursive
 /// partitioner splits off connected components first, so the zero eigenvalue
 /// is simple). Throws std::invalid_argument on a graph with fewer than two
 /// nodes or a node of zero degree, EigenSolverError if no solver converges
 /// (Lanczos failing on a graph above dense_fallback_max_size).
 FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options = {});
+
+/// The same, reusing `workspace`'s buffers (the same result to the bit).
+FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options, FiedlerWorkspace& workspace);
 
 }  // namespace obsgroup

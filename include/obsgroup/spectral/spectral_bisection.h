@@ -42,4 +42,8 @@ struct Bisection {
 Bisection spectralBisection(const WeightMatrix& W, SplitCriterion criterion,
                             const FiedlerOptions& options = {}, int min_side = 1);
 
+/// The same, the eigen solve reusing `workspace`'s buffers (the same result).
+Bisection spectralBisection(const WeightMatrix& W, SplitCriterion criterion, const FiedlerOptions& options,
+                            int min_side, FiedlerWorkspace& workspace);
+
 }  // namespace obsgroup
