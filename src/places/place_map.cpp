@@ -61,8 +61,9 @@ struct GridFrame {
 
 /// The grid over the regions' cells and a border of one cell: the floor
 /// lies in the regions, and an obstacle beyond them (a far return) says
-/// nothing of any place.
-GridFrame makeGrid(const ObservationRegions& regions, const Eigen::Vector3d& world_origin) {
+/// nothing of any place. `caller` names the function in the message of a
+/// grid too large.
+GridFrame makeGrid(const ObservationRegions& regions, const Eigen::Vector3d& world_origin, const std::string& caller) {
   const double cs = regions.cell_size;
   GridFrame f;
   f.grid.resolution = cs;
@@ -77,7 +78,7 @@ GridFrame makeGrid(const ObservationRegions& regions, const Eigen::Vector3d& wor
   const Eigen::Vector2i hi(f.cellX(highest.x()), f.cellY(highest.y()));
   const Eigen::Vector2d size = (hi - lo).cast<double>() + Eigen::Vector2d::Constant(3);
   if (size.x() * size.y() > 4.0e8)
-    throw std::invalid_argument("buildPlaceMap: the floor grid would have more than 400 million cells of " +
+    throw std::invalid_argument(caller + ": the floor grid would have more than 400 million cells of " +
                                 std::to_string(cs) + " m");
   f.first = lo - Eigen::Vector2i::Ones();
   f.grid.width = int(size.x());
@@ -720,11 +721,11 @@ FloorEvidence observeFloor(const ObservationRegions& regions, const Eigen::Vecto
                            const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
                            const PlaceOptions& options, int threads, const InterruptFlag* interrupt) {
   if (int(sensor_origins.size()) != regions.size())
-    throw std::invalid_argument("buildPlaceMap: regions and sensor origins of " + std::to_string(regions.size()) +
+    throw std::invalid_argument("observeFloor: regions and sensor origins of " + std::to_string(regions.size()) +
                                 " and " + std::to_string(sensor_origins.size()) + " observations");
   if (!(std::isfinite(options.band_low) && std::isfinite(options.band_high) && options.band_low < options.band_high))
-    throw std::invalid_argument("buildPlaceMap: the band must be finite with low < high");
-  const GridFrame f = makeGrid(regions, world_origin);
+    throw std::invalid_argument("observeFloor: the band must be finite with low < high");
+  const GridFrame f = makeGrid(regions, world_origin, "observeFloor");
   FloorEvidence floor;
   floor.grid = f.grid;
   floor.band_low = options.band_low;
@@ -764,7 +765,7 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const FloorEvidence& f
   checkPlaceInputs(regions.size(), sensor_origins, groups, place_ids, options);
   // The grid's cells are the regions' wherever the world origin lies: only
   // its origin in the world frame comes from the evidence.
-  GridFrame f = makeGrid(regions, Eigen::Vector3d::Zero());
+  GridFrame f = makeGrid(regions, Eigen::Vector3d::Zero(), "buildPlaceMap");
   const std::size_t cells = std::size_t(f.grid.width) * std::size_t(f.grid.height);
   if (floor.grid.width != f.grid.width || floor.grid.height != f.grid.height ||
       floor.grid.resolution != f.grid.resolution || floor.occupancy.size() != cells)

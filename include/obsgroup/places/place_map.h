@@ -167,8 +167,10 @@ struct FloorEvidence {
 /// The beams' evidence of the places' grid, on `threads` threads (0:
 /// OpenMP's default; the same bits for any count). Polls `interrupt` between
 /// observations and throws Interrupted when it is set. Throws
-/// std::invalid_argument as buildPlaceMap does, and rethrows what points_of
-/// throws.
+/// std::invalid_argument, naming observeFloor, when the sensor origins are
+/// not one per region, the band is not finite with low < high or the grid
+/// would exceed 400 million cells (buildPlaceMap, which calls it, reports a
+/// grid too large in the same words), and rethrows what points_of throws.
 FloorEvidence observeFloor(const ObservationRegions& regions, const Eigen::Vector3d& world_origin,
                            const PlacePointSource& points_of, const std::vector<Eigen::Vector3d>& sensor_origins,
                            const PlaceOptions& options = {}, int threads = 0,
