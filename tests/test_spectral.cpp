@@ -202,6 +202,25 @@ TEST(Fiedler, ItsOwnOrderingIsEigensAMDOrdering) {
   }
 }
 
+TEST(Fiedler, AWorkspaceReusedAcrossSizesGivesTheBitsOfAFreshSolve) {
+  // One workspace through solves of a large, a small, a dense and again a
+  // large graph (its buffers keep the largest's storage and the last
+  // factor): each result must be the bits of a solve with none.
+  FiedlerWorkspace workspace;
+  const FiedlerOptions sparse = withSolver(EigenSolver::Sparse);
+  for (const WeightMatrix& W : {routeGraph(1200, 8, 23), routeGraph(150, 4, 29), routeGraph(300, 60, 31),
+                                routeGraph(900, 10, 37)}) {
+    const FiedlerResult fresh = fiedlerVector(W, sparse);
+    const FiedlerResult reused = fiedlerVector(W, sparse, workspace);
+    EXPECT_GT(workspace.heldBytes(), 0u);
+    EXPECT_EQ(reused.sparse, fresh.sparse);
+    EXPECT_EQ(reused.eigenvalue, fresh.eigenvalue);
+    EXPECT_EQ(reused.y, fresh.y);
+    const Bisection b = spectralBisection(W, SplitCriterion::BestNcut, sparse, 1, workspace);
+    EXPECT_EQ(b.fiedler.y, fresh.y);
+  }
+}
+
 TEST(Fiedler, AUsersEliminationOrderGivesThePartitionOfTheSharedOne) {
   // recursivePartition orders the whole graph once and hands each subgraph its
   // members' ranks; a user's order of the whole graph is used the same way and
