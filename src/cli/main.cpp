@@ -12,9 +12,13 @@
 
 #include <signal.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
 
@@ -57,10 +61,27 @@ void preferTransparentHugePages(char** argv) {
 #endif
 }
 
+/// The stages of a large run free and allocate hundreds of megabytes in
+/// turn. By default glibc grows its heap by exactly what each allocation
+/// lacks and gives the top back as soon as it is free, so the next stage
+/// faults the same pages in again (100,100 scans: about 250,000 page faults,
+/// 3.8 s of system time). Growing it 64 MiB at a time halves the faults
+/// (docs/performance.md); the run's peak is unchanged, since pages are only
+/// resident once written and the stages still hand their memory back
+/// (returnFreedMemory). A user's own glibc.malloc.top_pad is kept.
+void padHeapGrowth() {
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (tunables != nullptr && std::strstr(tunables, "top_pad") != nullptr) return;
+  mallopt(M_TOP_PAD, 64 << 20);
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   preferTransparentHugePages(argv);
+  padHeapGrowth();
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // obsgroup words its own errors
 
   const auto usage = [](const std::string& message) {
