@@ -157,6 +157,36 @@ TEST(Degenerate, WeightsThatAreNotOverlapsAreRefused) {
   EXPECT_THROW(recursivePartition(one_sided), std::invalid_argument);
 }
 
+// The online overload checks only the rows flagged changed once its cache
+// holds a checked run, yet refuses a bad weight in such a row, and after a
+// refusal checks every row again: the caller need not flag the bad row twice.
+TEST(Degenerate, TheCachedPartitionRefusesBadWeightsInTheRowsThatChanged) {
+  const auto graph = [](double w23, double w32) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j)
+        if (i != j) t.emplace_back(i, j, (i < 3) == (j < 3) ? 1.0 : 0.01);
+    WeightMatrix W(6, 6);
+    W.setFromTriplets(t.begin(), t.end());
+    W.coeffRef(2, 3) = w23;
+    W.coeffRef(3, 2) = w32;
+    return W;
+  };
+  const std::vector<int> ids{0, 1, 2, 3, 4, 5};
+  const std::vector<char> none(6, 0), rows_2_3{0, 0, 1, 1, 0, 0};
+  PartitionOptions options;
+  options.min_group_size = 1;
+  SplitCache cache;
+  EXPECT_THROW(recursivePartition(graph(0.01, 0.5), options, ids, none, cache), std::invalid_argument)
+      << "a cold cache checks every row";
+  const Partition good = recursivePartition(graph(0.01, 0.01), options, ids, none, cache);
+  EXPECT_EQ(good.groups, (std::vector<std::vector<int>>{{0, 1, 2}, {3, 4, 5}}));
+  EXPECT_THROW(recursivePartition(graph(-0.01, -0.01), options, ids, rows_2_3, cache), std::invalid_argument);
+  EXPECT_THROW(recursivePartition(graph(0.01, 0.5), options, ids, none, cache), std::invalid_argument)
+      << "after a refusal the next run checks every row";
+  EXPECT_EQ(recursivePartition(graph(0.01, 0.01), options, ids, none, cache).groups, good.groups);
+}
+
 TEST(Degenerate, LanczosFailureFallsBackToTheDenseSolverWithAWarning) {
   const WeightMatrix W = pathGraph(400);
   FiedlerOptions no_fallback = starvedLanczos().eigen;

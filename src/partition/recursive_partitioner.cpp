@@ -72,6 +72,9 @@ struct SplitCache::Store {
   };
   std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
   std::size_t reused = 0, computed = 0;
+  /// Filled by a run that checked every row of its W (checkWeights), or
+  /// whose unchanged rows an earlier such run had checked.
+  bool weights_checked = false;
 
   Entry* find(const std::vector<int>& member_ids, int depth) {
     const auto it = entries.find(nodeKey(member_ids, depth));
@@ -349,9 +352,11 @@ const double* mirrorEntry(const WeightMatrix& W, Eigen::Index row, Eigen::Index 
 /// Weights are overlaps: finite, non-negative and symmetric. Anything else
 /// would make Ncut meaningless, so it is refused rather than partitioned.
 /// Each entry's mirror is looked up in place: a transposed copy of W would
-/// be the largest allocation of a large run's partition.
-void checkWeights(const WeightMatrix& W) {
-  for (Eigen::Index c = 0; c < W.outerSize(); ++c)
+/// be the largest allocation of a large run's partition. With `rows`, only
+/// the rows flagged in it (and the mirrors of their entries) are checked.
+void checkWeights(const WeightMatrix& W, const std::vector<char>* rows = nullptr) {
+  for (Eigen::Index c = 0; c < W.outerSize(); ++c) {
+    if (rows && !(*rows)[std::size_t(c)]) continue;
     for (WeightMatrix::InnerIterator it(W, c); it; ++it) {
       const double w = it.value();
       if (!std::isfinite(w) || w < 0.0)
@@ -363,6 +368,7 @@ void checkWeights(const WeightMatrix& W) {
         throw std::invalid_argument("recursivePartition: W is not symmetric near (" +
                                     std::to_string(it.row()) + ", " + std::to_string(it.col()) + ")");
     }
+  }
 }
 
 /// PartitionOptions::boundary_passes: each observation joins the group with
@@ -451,8 +457,17 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     throw std::invalid_argument("recursivePartition: one id and one changed flag per node expected");
   if (!std::is_sorted(ids.begin(), ids.end()) || std::adjacent_find(ids.begin(), ids.end()) != ids.end())
     throw std::invalid_argument("recursivePartition: node ids must ascend");
-  checkWeights(W);
+  // The rows that did not change were checked by the run that filled the
+  // cache (or one before it): at 10,000 scans, checking all of W was about
+  // 5% of an online update.
+  try {
+    checkWeights(W, cache.store_->weights_checked ? &changed : nullptr);
+  } catch (...) {
+    cache.clear();  // the caller may not flag the refused rows again: the next run checks them all
+    throw;
+  }
   auto next = std::make_shared<SplitCache::Store>();
+  next->weights_checked = true;
   Reuse reuse{ids, changed, *cache.store_, *next, *cache.workspaces_};
   try {
     Partition partition = Partitioner(W, options, &reuse).run();
