@@ -65,7 +65,7 @@ void preferTransparentHugePages(char** argv) {
 /// turn. By default glibc grows its heap by exactly what each allocation
 /// lacks and gives the top back as soon as it is free, so the next stage
 /// faults the same pages in again (100,100 scans: about 250,000 page faults,
-/// 3.8 s of system time). Growing it 64 MiB at a time halves the faults
+/// 4-5 s of system time). Growing it 64 MiB at a time halves the faults
 /// (docs/performance.md); the run's peak is unchanged, since pages are only
 /// resident once written and the stages still hand their memory back
 /// (returnFreedMemory). A user's own glibc.malloc.top_pad is kept.

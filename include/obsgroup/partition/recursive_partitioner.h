@@ -133,7 +133,11 @@ class SplitCache {
 /// that filled the cache keep their order), and changed[k] != 0 when its row
 /// of W may differ from that run's. The options must be those of that run
 /// (the cache does not check them; clear it when they change), and
-/// options.eigen.elimination_rank must be empty.
+/// options.eigen.elimination_rank must be empty. Weights are refused as by
+/// the overload above, but once the cache holds a run's decisions only the
+/// rows flagged changed are checked: an unflagged row is the one checked
+/// before. After a refusal the cache is cleared, and the next run checks
+/// every row.
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
                              const std::vector<char>& changed, SplitCache& cache);
 
