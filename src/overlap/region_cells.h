@@ -164,6 +164,30 @@ void traverse(const std::array<double, D>& from, const std::array<double, D>& to
     budget += std::abs(last[a] - cell[a]);
   }
   double t = 0.0;
+  if constexpr (D == 2) {
+    // The plane's walk, the inner loop of every view: the same steps as
+    // below, with the axis chosen by selects rather than a branch the
+    // processor cannot predict (a ray's x and y steps alternate), and the
+    // state in registers rather than arrays indexed by the axis. Adding 0.0
+    // to the axis not taken leaves it to the bit.
+    std::int64_t x = cell[0], y = cell[1];
+    double next_x = next[0], next_y = next[1];
+    const std::int64_t last_x = last[0], last_y = last[1];
+    const std::int64_t step_x = step[0], step_y = step[1];
+    const double step_tx = step_t[0], step_ty = step_t[1];
+    for (std::int64_t k = 0; k < budget; ++k) {
+      if (!visit(Cell<2>{x, y}, t) || (x == last_x && y == last_y)) return;
+      const bool along_y = next_y < next_x;
+      const double reached = along_y ? next_y : next_x;
+      if (reached > 1.0) return;
+      t = reached;
+      x += along_y ? 0 : step_x;
+      y += along_y ? step_y : 0;
+      next_x += along_y ? 0.0 : step_tx;
+      next_y += along_y ? step_ty : 0.0;
+    }
+    return;
+  }
   // The budget (the cells between the end cells) bounds the walk whatever
   // the rounding of `next`.
   for (std::int64_t k = 0; k < budget; ++k) {
