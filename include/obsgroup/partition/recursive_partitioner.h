@@ -135,9 +135,12 @@ class SplitCache {
 /// (the cache does not check them; clear it when they change), and
 /// options.eigen.elimination_rank must be empty. Weights are refused as by
 /// the overload above, but once the cache holds a run's decisions only the
-/// rows flagged changed are checked: an unflagged row is the one checked
-/// before. After a refusal the cache is cleared, and the next run checks
-/// every row.
+/// rows flagged changed (and the mirrors of their entries) are checked: an
+/// unflagged row is taken to be the one checked before, so an entry of an
+/// unflagged row whose mirror a changed row no longer holds is not found. A
+/// caller that flags every row that differs cannot make one from a W that
+/// was symmetric. After a refusal the cache is cleared, and the next run
+/// checks every row.
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
                              const std::vector<char>& changed, SplitCache& cache);
 
