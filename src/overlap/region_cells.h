@@ -120,6 +120,19 @@ class RegionMarker {
       }
       return;
     }
+    if constexpr (D == 2) {
+      // Bits ascend, so the row (x) is found by moving on from the last
+      // one's rather than by a division per cell.
+      const std::uint64_t row_length = std::uint64_t(extent_[1]);
+      std::uint64_t row = 0, row_start = 0;
+      for (std::size_t w = 0; w < bits_.size(); ++w)
+        for (std::uint64_t word = bits_[w]; word; word &= word - 1) {
+          const std::uint64_t b = w * 64 + std::uint64_t(__builtin_ctzll(word));
+          while (b - row_start >= row_length) ++row, row_start += row_length;
+          visit(keyOf<2>(Cell<2>{lo_[0] + std::int64_t(row), lo_[1] + std::int64_t(b - row_start)}));
+        }
+      return;
+    }
     for (std::size_t w = 0; w < bits_.size(); ++w)
       for (std::uint64_t word = bits_[w]; word; word &= word - 1) {
         std::uint64_t b = w * 64 + std::uint64_t(__builtin_ctzll(word));
@@ -145,11 +158,61 @@ class RegionMarker {
   std::vector<std::uint64_t> keys_, removed_;
 };
 
+/// One segment's walk through the plane's cells (Amanatides and Woo), held
+/// as a state so that walks can advance in turn (traversePair): the plane's
+/// walk is the inner loop of every view and of the occupancy evidence, and
+/// each step waits on the one before it. The axis is chosen by selects rather
+/// than a branch the processor cannot predict (a ray's x and y steps
+/// alternate); adding 0.0 to the axis not taken leaves it to the bit.
+class PlaneWalk {
+ public:
+  PlaneWalk(const std::array<double, 2>& from, const std::array<double, 2>& to) {
+    x_ = std::int64_t(std::floor(from[0])), y_ = std::int64_t(std::floor(from[1]));
+    last_x_ = std::int64_t(std::floor(to[0])), last_y_ = std::int64_t(std::floor(to[1]));
+    const double dx = to[0] - from[0], dy = to[1] - from[1];
+    step_x_ = dx > 0 ? 1 : -1, step_y_ = dy > 0 ? 1 : -1;
+    step_tx_ = dx != 0 ? 1.0 / std::abs(dx) : std::numeric_limits<double>::infinity();
+    step_ty_ = dy != 0 ? 1.0 / std::abs(dy) : std::numeric_limits<double>::infinity();
+    next_x_ = dx != 0 ? (double(x_ + (dx > 0)) - from[0]) / dx : std::numeric_limits<double>::infinity();
+    next_y_ = dy != 0 ? (double(y_ + (dy > 0)) - from[1]) / dy : std::numeric_limits<double>::infinity();
+    // The budget (the cells between the end cells) bounds the walk whatever
+    // the rounding of `next`.
+    remaining_ = 1 + std::abs(last_x_ - x_) + std::abs(last_y_ - y_);
+  }
+
+  /// Visits the current cell (visit(cell, t) returns false to stop) and
+  /// steps to the next; false once the walk has ended.
+  template <typename Visit>
+  bool advance(Visit& visit) {
+    if (remaining_-- <= 0) return false;
+    if (!visit(Cell<2>{x_, y_}, t_) || (x_ == last_x_ && y_ == last_y_)) return false;
+    const bool along_y = next_y_ < next_x_;
+    const double reached = along_y ? next_y_ : next_x_;
+    if (reached > 1.0) return false;
+    t_ = reached;
+    x_ += along_y ? 0 : step_x_;
+    y_ += along_y ? step_y_ : 0;
+    next_x_ += along_y ? 0.0 : step_tx_;
+    next_y_ += along_y ? step_ty_ : 0.0;
+    return true;
+  }
+
+ private:
+  std::int64_t x_, y_, last_x_, last_y_, step_x_, step_y_, remaining_;
+  double next_x_, next_y_, step_tx_, step_ty_, t_ = 0.0;
+};
+
 /// Visits the cells a segment from `from` to `to` (in cell units) crosses, in
 /// order (Amanatides and Woo). `visit(cell, t)` gets the parameter t in [0, 1]
 /// at which the segment enters the cell and returns false to stop.
 template <int D, typename Visit>
 void traverse(const std::array<double, D>& from, const std::array<double, D>& to, Visit&& visit) {
+  if constexpr (D == 2) {
+    PlaneWalk walk(from, to);
+    while (walk.advance(visit)) {
+    }
+    return;
+  }
   Cell<D> cell, last;
   std::array<double, D> next, step_t;
   std::array<int, D> step;
@@ -164,30 +227,6 @@ void traverse(const std::array<double, D>& from, const std::array<double, D>& to
     budget += std::abs(last[a] - cell[a]);
   }
   double t = 0.0;
-  if constexpr (D == 2) {
-    // The plane's walk, the inner loop of every view: the same steps as
-    // below, with the axis chosen by selects rather than a branch the
-    // processor cannot predict (a ray's x and y steps alternate), and the
-    // state in registers rather than arrays indexed by the axis. Adding 0.0
-    // to the axis not taken leaves it to the bit.
-    std::int64_t x = cell[0], y = cell[1];
-    double next_x = next[0], next_y = next[1];
-    const std::int64_t last_x = last[0], last_y = last[1];
-    const std::int64_t step_x = step[0], step_y = step[1];
-    const double step_tx = step_t[0], step_ty = step_t[1];
-    for (std::int64_t k = 0; k < budget; ++k) {
-      if (!visit(Cell<2>{x, y}, t) || (x == last_x && y == last_y)) return;
-      const bool along_y = next_y < next_x;
-      const double reached = along_y ? next_y : next_x;
-      if (reached > 1.0) return;
-      t = reached;
-      x += along_y ? 0 : step_x;
-      y += along_y ? step_y : 0;
-      next_x += along_y ? 0.0 : step_tx;
-      next_y += along_y ? step_ty : 0.0;
-    }
-    return;
-  }
   // The budget (the cells between the end cells) bounds the walk whatever
   // the rounding of `next`.
   for (std::int64_t k = 0; k < budget; ++k) {
@@ -200,6 +239,24 @@ void traverse(const std::array<double, D>& from, const std::array<double, D>& to
     cell[axis] += step[axis];
     next[axis] += step_t[axis];
   }
+}
+
+/// traverse<2> of two segments at once, their steps taken in turn so that
+/// the two chains of dependent steps overlap: each segment's cells are
+/// visited in its own order by its own visitor, the two sequences
+/// interleaved. On the occupancy evidence of 360-beam scans the pair walks
+/// took about a quarter less time than one ray after another.
+template <typename VisitA, typename VisitB>
+void traversePair(const std::array<double, 2>& from, const std::array<double, 2>& to_a, VisitA&& visit_a,
+                  const std::array<double, 2>& to_b, VisitB&& visit_b) {
+  PlaneWalk a(from, to_a), b(from, to_b);
+  bool on_a = true, on_b = true;
+  while (on_a && on_b) {
+    on_a = a.advance(visit_a);
+    on_b = b.advance(visit_b);
+  }
+  while (on_a) on_a = a.advance(visit_a);
+  while (on_b) on_b = b.advance(visit_b);
 }
 
 /// The cell grid, anchored on the first observation (the origin of the
@@ -587,63 +644,97 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     widths.doors_for = doors_for;
   }
   const auto& directions = widths.directions;
-  const auto walk = [&](int r, auto&& free_cell, auto&& seen) {
-    const std::array<double, 2> end{o[0] + range * directions[r][0], o[1] + range * directions[r][1]};
+  const auto ray_end = [&](int r) {
+    return std::array<double, 2>{o[0] + range * directions[r][0], o[1] + range * directions[r][1]};
+  };
+  // The visitor of ray r's walk through the cells it sees: free_cell(cell,
+  // widths) on each free one (false stops it), seen(cell) on every cell.
+  const auto ray_visitor = [&](int r, auto& free_cell, auto& seen) {
     // Where the observation looked, its own beams say what it saw: only its
     // own surfaces stop the ray, so drifted copies of other observations'
     // walls do not cut its view. Elsewhere (behind a forward laser, beside
     // a camera) the occupancy of all observations stands in for its eyes.
-    const bool own_view = covered[r];
+    const bool own_view = covered[r] != 0;
+    const OpeningWidths* ray_widths = own_view ? &widths.own : &widths.shared;
     // Only the occupied cells a ray starts among are passed, and only
     // within the clearance: once it has crossed a free cell, the next
     // occupied cell is a wall seen from inside and stops it.
-    bool crossed_free = false;
-    traverse<2>(o, end, [&](const Cell<2>& c, double t) {
+    return [&free_cell, &seen, &own, &occupancy, clear, own_view, ray_widths, crossed_free = false](
+               const Cell<2>& c, double t) mutable {
       seen(c);
       if (!own.marked(c) && (own_view || !occupancy.occupied(c))) {
         crossed_free = true;
-        return free_cell(c, own_view ? widths.own : widths.shared);
+        return bool(free_cell(c, *ray_widths));
       }
       return !crossed_free && t < clear;
-    });
+    };
   };
+  // Walks every ray: walk_two(r, q) for two at a time (traversePair), their
+  // cells marked in any order; walk_one(r) for an odd last one.
+  const auto walk_rays = [&](auto&& walk_one, auto&& walk_two) {
+    int r = 0;
+    for (; r + 1 < rays; r += 2) walk_two(r, r + 1);
+    if (r < rays) walk_one(r);
+  };
+  const auto ignore = [](const Cell<2>&) {};
   // A pose in a doorway (its rays start narrow) stands on the side whose
   // wide space is nearer: each ray's narrow cells before its first wide one,
   // -1 when it never reaches wide space.
   std::vector<int>& to_wide = widths.to_wide;
   if (doors) {
     to_wide.assign(rays, -1);
-    for (int r = 0; r < rays; ++r) {
-      const DoorCrossing& probe = widths.doors[r];
-      int narrow = 0;
-      walk(
-          r,
-          [&](const Cell<2>& c, const OpeningWidths& w) {
-            if (probe.narrowAt(c, w)) {
-              ++narrow;
-              return true;
-            }
-            to_wide[r] = narrow;
-            return false;
-          },
-          [](const Cell<2>&) {});
-    }
+    const auto probe = [&](int r, int& narrow) {
+      return [&widths, &to_wide, &narrow, r](const Cell<2>& c, const OpeningWidths& w) {
+        if (widths.doors[r].narrowAt(c, w)) {
+          ++narrow;
+          return true;
+        }
+        to_wide[r] = narrow;
+        return false;
+      };
+    };
+    walk_rays(
+        [&](int r) {
+          int narrow = 0;
+          auto free_cell = probe(r, narrow);
+          traverse<2>(o, ray_end(r), ray_visitor(r, free_cell, ignore));
+        },
+        [&](int r, int q) {
+          int narrow_r = 0, narrow_q = 0;
+          auto free_r = probe(r, narrow_r);
+          auto free_q = probe(q, narrow_q);
+          traversePair(o, ray_end(r), ray_visitor(r, free_r, ignore), ray_end(q), ray_visitor(q, free_q, ignore));
+        });
   }
   marker.reset(lo, hi);
-  for (int r = 0; r < rays; ++r) {
-    // A ray that comes through a door stops in the first wide cell beyond
-    // it: the view is of the place the observation stands in. From a
-    // doorway, the far side is beyond the door.
+  // A ray that comes through a door stops in the first wide cell beyond
+  // it: the view is of the place the observation stands in. From a
+  // doorway, the far side is beyond the door.
+  const auto door_of = [&](int r) {
     DoorCrossing door = widths.doors[r];
     if (doors) {
       const int opposite = to_wide[(r + rays / 2) % rays];
       // More than one cell nearer: a pose in the middle of the doorway sees both sides.
       if (to_wide[r] > 0 && opposite >= 0 && opposite + 1 < to_wide[r]) door.startInDoorway();
     }
-    walk(
-        r, [&](const Cell<2>& c, const OpeningWidths& w) { return !doors || !door.throughDoor(c, w); },
-        [&](const Cell<2>& c) { marker.mark(c); });
-  }
+    return door;
+  };
+  const auto stop_at_door = [doors](DoorCrossing& door) {
+    return [&door, doors](const Cell<2>& c, const OpeningWidths& w) { return !doors || !door.throughDoor(c, w); };
+  };
+  auto mark = [&marker](const Cell<2>& c) { marker.mark(c); };
+  walk_rays(
+      [&](int r) {
+        DoorCrossing door = door_of(r);
+        auto free_cell = stop_at_door(door);
+        traverse<2>(o, ray_end(r), ray_visitor(r, free_cell, mark));
+      },
+      [&](int r, int q) {
+        DoorCrossing door_r = door_of(r), door_q = door_of(q);
+        auto free_r = stop_at_door(door_r);
+        auto free_q = stop_at_door(door_q);
+        traversePair(o, ray_end(r), ray_visitor(r, free_r, mark), ray_end(q), ray_visitor(q, free_q, mark));
+      });
   marker.emit(out);
 }
 
@@ -689,11 +780,13 @@ void occupancyEvidence(PointSpan points, const Eigen::Vector3d& origin, const Re
   for (const Cell<2>& c : s.ends) s.marker.mark(c);
   s.marker.forEachMarked(hit);
   s.marker.reset(lo, hi);
-  for (const auto& e : s.targets)
-    traverse<2>(o, e, [&](const Cell<2>& c, double) {
-      s.marker.mark(c);
-      return true;
-    });
+  const auto mark = [&](const Cell<2>& c, double) {
+    s.marker.mark(c);
+    return true;
+  };
+  std::size_t k = 0;
+  for (; k + 1 < s.targets.size(); k += 2) traversePair(o, s.targets[k], mark, s.targets[k + 1], mark);
+  if (k < s.targets.size()) traverse<2>(o, s.targets[k], mark);
   for (const Cell<2>& c : s.ends) s.marker.unmark(c);  // a surface it saw is not a cell it saw through
   s.marker.forEachMarked(crossed);
 }
