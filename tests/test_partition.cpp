@@ -222,6 +222,57 @@ TEST(RecursivePartition, BoundaryRefinementKeepsTheMinimumGroupSize) {
   }
 }
 
+// Three rooms in a row, weakly joined: a new link from room A to room C
+// changes the rows of one node in each, but the block of W of the node
+// holding B and C only where A's node is: told that node 0 is the source,
+// the cache copies B and C's node and its children, and the tree is still
+// the one computed from scratch, to the bit.
+TEST(RecursivePartition, TheSplitCacheCopiesTheNodesThatHoldNoSourceOfAChange) {
+  const auto rooms = [](double a_to_c) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < 24; ++i)
+      for (int j = 0; j < 24; ++j) {
+        if (i == j) continue;
+        const int ri = i / 8, rj = j / 8;
+        const double w = ri == rj ? 1.0 - 0.01 * ((i + j) % 5) : std::abs(ri - rj) == 1 ? 0.02 : 0.0;
+        if (w > 0) t.emplace_back(i, j, w);
+      }
+    t.emplace_back(0, 20, a_to_c);
+    t.emplace_back(20, 0, a_to_c);
+    WeightMatrix W(24, 24);
+    W.setFromTriplets(t.begin(), t.end());
+    return W;
+  };
+  PartitionOptions options;
+  options.min_group_size = 1;
+  std::vector<int> ids(24);
+  for (int i = 0; i < 24; ++i) ids[i] = i;
+  const std::vector<char> none(24, 0);
+  SplitCache by_rows, by_sources;
+  recursivePartition(rooms(0.0), options, ids, none, by_rows);
+  recursivePartition(rooms(0.0), options, ids, none, none, by_sources);
+  std::vector<char> changed(24, 0), sources(24, 0);
+  changed[0] = changed[20] = 1;
+  sources[0] = 1;
+  const WeightMatrix W = rooms(0.01);
+  const Partition fresh = recursivePartition(W, options);
+  const Partition rows = recursivePartition(W, options, ids, changed, by_rows);
+  const Partition from_sources = recursivePartition(W, options, ids, changed, sources, by_sources);
+  ASSERT_EQ(fresh.groups.size(), 3u);
+  for (const Partition* p : {&rows, &from_sources}) {
+    EXPECT_EQ(p->groups, fresh.groups);
+    ASSERT_EQ(p->splits.size(), fresh.splits.size());
+    for (std::size_t k = 0; k < fresh.splits.size(); ++k) {
+      EXPECT_EQ(p->splits[k].members, fresh.splits[k].members);
+      EXPECT_EQ(p->splits[k].accepted, fresh.splits[k].accepted);
+      EXPECT_EQ(0, std::memcmp(&p->splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << "node " << k;
+      EXPECT_EQ(0, std::memcmp(&p->splits[k].threshold, &fresh.splits[k].threshold, sizeof(double))) << "node " << k;
+    }
+  }
+  EXPECT_GT(by_sources.reusedNodes(), by_rows.reusedNodes());
+  EXPECT_LT(by_sources.computedNodes(), by_rows.computedNodes());
+}
+
 TEST(Keyframes, AFrameIsAKeyframeWhenItMovedOrTurnedEnoughSinceTheLast) {
   std::vector<Eigen::Isometry3d> poses;
   for (int k = 0; k < 8; ++k) poses.push_back(pose2D(0.04 * k, 0.0, 0.0));  // 4 cm a frame

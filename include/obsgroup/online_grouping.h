@@ -171,6 +171,7 @@ class OnlineGrouping {
   int exact_interval_ = 1;
   int changes_since_exact_ = 0;       // observations inserted or moved since the last exact update
   std::vector<char> pending_;         // by id: row changed since the last exact update
+  std::vector<char> pending_sources_; // by id: own data changed since then (the entries' sources)
   std::vector<int> moved_;            // ids inserted, moved or removed since the last update
   bool exact_once_ = false;           // an exact update has been made (the cache holds its tree)
 };

@@ -105,6 +105,7 @@ struct IncrementalOverlap::State {
   OccupancyGrid occupancy;                                         // visibility
   std::unordered_map<std::uint64_t, std::vector<int>> watchers;    // region models: slots holding each cell
   std::vector<char> changed;                                       // rows changed since the last update
+  std::vector<char> sources;                                       // slots whose own points or region changed
   std::size_t recomputed = 0;
 
   State(SensedSpaceModel m, double d, const RegionParameters& p) : model(m), delta(d), params(p), grid(p.cell_size) {}
@@ -118,6 +119,12 @@ struct IncrementalOverlap::State {
   void markChanged(int slot) {
     if (slot >= int(changed.size())) changed.resize(slots.size(), 0);
     changed[slot] = 1;
+  }
+  /// Every pair that changes has a source at one end: a slot given new
+  /// points, or whose region now holds other cells.
+  void markSource(int slot) {
+    if (slot >= int(sources.size())) sources.resize(slots.size(), 0);
+    sources[slot] = 1;
   }
 
   // --- pair counts, kept symmetric in the rows of both slots ---
@@ -177,6 +184,7 @@ struct IncrementalOverlap::State {
       s.region.clear(), s.hit.clear(), s.crossed.clear(), s.row.clear();
       s.dirty = s.present;
       markChanged(i);
+      markSource(i);
     }
     stale = false;
   }
@@ -192,6 +200,7 @@ struct IncrementalOverlap::State {
     for (int d : dirty) {
       clearRow(d);
       markChanged(d);
+      markSource(d);
     }
     // The pairs of each changed observation, each pair once.
     std::vector<std::pair<int, int>> pairs;
@@ -356,6 +365,7 @@ struct IncrementalOverlap::State {
     for (std::size_t k = 0; k < affected.size(); ++k) {
       const int i = affected[k];
       const std::vector<std::uint64_t>& now = slots[i].region;
+      if (now != old[k] || slots[i].dirty) markSource(i);
       if (now.size() != old[k].size()) markPartners(i);
       for (std::uint64_t key : difference(old[k], now)) removeCell(i, key, shared);
       for (std::uint64_t key : difference(now, old[k])) addCell(i, key, shared);
@@ -430,6 +440,7 @@ std::vector<int> IncrementalOverlap::update(int threads, const InterruptFlag* in
   throwIfInterrupted(interrupt);
   threads = threadCount(threads);
   s.changed.assign(s.slots.size(), 0);
+  s.sources.assign(s.slots.size(), 0);
   if (s.model != SensedSpaceModel::Points) {
     const bool planar = s.planarNow();
     if (planar != s.planar_used) s.stale = true;
@@ -446,6 +457,14 @@ std::vector<int> IncrementalOverlap::update(int threads, const InterruptFlag* in
   std::vector<int> out;
   for (int i = 0; i < int(s.changed.size()); ++i)
     if (s.changed[i] && s.present(i)) out.push_back(i);
+  return out;
+}
+
+std::vector<int> IncrementalOverlap::sourcesOfLastUpdate() const {
+  const State& s = *state_;
+  std::vector<int> out;
+  for (int i = 0; i < int(s.sources.size()); ++i)
+    if (s.sources[i] && s.present(i)) out.push_back(i);
   return out;
 }
 

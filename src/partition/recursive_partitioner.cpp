@@ -51,11 +51,12 @@ std::uint64_t nodeKey(const std::vector<int>& member_ids, int depth) {
   return h ^ (std::uint64_t(member_ids.size()) << 32);
 }
 
-/// What the partitioner reuses and records: the ids of W's nodes, which
-/// rows changed, and the decisions of the previous and of this run.
+/// What the partitioner reuses and records: the ids of W's nodes, the nodes
+/// at one end of every entry that changed (sources), and the decisions of
+/// the previous and of this run.
 struct Reuse {
   const std::vector<int>& ids;
-  const std::vector<char>& changed;
+  const std::vector<char>& sources;
   SplitCache::Store& previous;  // a copied decision is moved on to `next` when recorded
   SplitCache::Store& next;
   std::vector<FiedlerWorkspace>& workspaces;  // kept from one run to the next
@@ -192,12 +193,13 @@ class Partitioner {
     return ids;
   }
 
-  /// The previous run's decision of this node, when none of its members'
-  /// rows changed: its block of W, hence its decision, is the same.
+  /// The previous run's decision of this node, when none of its members is
+  /// a source: every entry that changed has a source at one end, so none of
+  /// its block did, and its block of W, hence its decision, is the same.
   bool copyCachedDecision(const SplitNode& current, Decision& d) const {
     if (!reuse_) return false;
     for (int i : current.members)
-      if (reuse_->changed[i]) return false;
+      if (reuse_->sources[i]) return false;
     const auto* entry = reuse_->previous.find(idsOf(current.members), current.depth);
     if (!entry) return false;
     d = entry->decision;
@@ -446,6 +448,11 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
 
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
                              const std::vector<char>& changed, SplitCache& cache) {
+  return recursivePartition(W, options, ids, changed, changed, cache);
+}
+
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
+                             const std::vector<char>& changed, const std::vector<char>& sources, SplitCache& cache) {
   if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
@@ -453,8 +460,9 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
   if (!options.eigen.elimination_rank.empty())
     throw std::invalid_argument("recursivePartition: a split cache needs each node to order itself (no elimination_rank)");
-  if (Eigen::Index(ids.size()) != W.rows() || Eigen::Index(changed.size()) != W.rows())
-    throw std::invalid_argument("recursivePartition: one id and one changed flag per node expected");
+  if (Eigen::Index(ids.size()) != W.rows() || Eigen::Index(changed.size()) != W.rows() ||
+      Eigen::Index(sources.size()) != W.rows())
+    throw std::invalid_argument("recursivePartition: one id, one changed flag and one source flag per node expected");
   if (!std::is_sorted(ids.begin(), ids.end()) || std::adjacent_find(ids.begin(), ids.end()) != ids.end())
     throw std::invalid_argument("recursivePartition: node ids must ascend");
   // The rows that did not change were checked by the run that filled the
@@ -468,7 +476,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   }
   auto next = std::make_shared<SplitCache::Store>();
   next->weights_checked = true;
-  Reuse reuse{ids, changed, *cache.store_, *next, *cache.workspaces_};
+  Reuse reuse{ids, sources, *cache.store_, *next, *cache.workspaces_};
   try {
     Partition partition = Partitioner(W, options, &reuse).run();
     cache.store_ = std::move(next);

@@ -177,6 +177,8 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   W_ = overlap_->weightMatrix(params_.diagonal_weight);
   pending_.resize(slots_.size(), 0);
   for (int slot : changed_slots) pending_[slot] = 1;
+  pending_sources_.resize(slots_.size(), 0);
+  for (int slot : overlap_->sourcesOfLastUpdate()) pending_sources_[slot] = 1;
   out.exact = force_exact || !exact_once_ || exact_interval_ <= 1 || changes_since_exact_ >= exact_interval_;
   std::vector<std::vector<int>> groups;
   if (out.exact) {
@@ -205,11 +207,15 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
 template <typename PointT>
 std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std::vector<int>& ids, GroupUpdate& out) {
   std::vector<char> changed(ids.size(), 0);
-  for (std::size_t k = 0; k < ids.size(); ++k) changed[k] = pending_[ids[k]];
-  partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, cache_);
+  std::vector<char> sources(ids.size(), 0);
+  for (std::size_t k = 0; k < ids.size(); ++k) changed[k] = pending_[ids[k]], sources[k] = pending_sources_[ids[k]];
+  // Only the nodes holding a source are solved again: a new observation
+  // changes its neighbours' rows, not the blocks of the nodes without it.
+  partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, sources, cache_);
   out.split_nodes_reused = cache_.reusedNodes();
   out.split_nodes_computed = cache_.computedNodes();
   std::fill(pending_.begin(), pending_.end(), 0);
+  std::fill(pending_sources_.begin(), pending_sources_.end(), 0);
   changes_since_exact_ = 0;
   exact_once_ = true;
   std::vector<std::vector<int>> groups;

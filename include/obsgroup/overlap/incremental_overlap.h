@@ -56,6 +56,11 @@ class IncrementalOverlap {
   /// changed since the last update(), ascending. `threads`: 0 for all cores;
   /// the result does not depend on it.
   std::vector<int> update(int threads = 0, const InterruptFlag* interrupt = nullptr);
+  /// The slots present whose own data changed in the last update(): points
+  /// set, or a region recomputed to other cells. Every pair of W that
+  /// changed has one of them at an end (or both), so a set of slots holding
+  /// none of them has the same block of W (recursivePartition's sources).
+  std::vector<int> sourcesOfLastUpdate() const;
 
   /// The slots present, ascending (node k of weightMatrix() is slots()[k]).
   std::vector<int> slots() const;

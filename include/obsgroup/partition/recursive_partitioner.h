@@ -120,7 +120,7 @@ class SplitCache {
 
  private:
   friend Partition recursivePartition(const WeightMatrix&, const PartitionOptions&, const std::vector<int>&,
-                                      const std::vector<char>&, SplitCache&);
+                                      const std::vector<char>&, const std::vector<char>&, SplitCache&);
   std::shared_ptr<Store> store_;
   /// The eigen solves' buffers, one per thread, kept from one run to the
   /// next: the nodes solved again after an insert are about as large as
@@ -143,5 +143,18 @@ class SplitCache {
 /// checks every row.
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
                              const std::vector<char>& changed, SplitCache& cache);
+
+/// As above, with fewer nodes solved again when the caller knows where the
+/// changes came from: sources[k] != 0 for each node whose own data changed
+/// (an observation inserted or moved, a region recomputed to other cells),
+/// such that every entry of W that may differ from the cached run's has a
+/// source at one end or both. A node none of whose members is a source then
+/// has the same block of W, even where its rows changed through entries
+/// that lead out of it (a new observation's entries change its neighbours'
+/// rows, not the block of a node without it), and its decision is copied.
+/// `changed` still flags every row that differs (the weights check reads
+/// it). The overload above is this one with sources = changed.
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
+                             const std::vector<char>& changed, const std::vector<char>& sources, SplitCache& cache);
 
 }  // namespace obsgroup
