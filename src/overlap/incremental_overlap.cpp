@@ -5,6 +5,7 @@
 #include "region_cells.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -106,6 +107,12 @@ struct IncrementalOverlap::State {
   std::unordered_map<std::uint64_t, std::vector<int>> watchers;    // region models: slots holding each cell
   std::vector<char> changed;                                       // rows changed since the last update
   std::vector<char> sources;                                       // slots whose own points or region changed
+  // The last W built (weightMatrix): its slots, diagonal and entry count,
+  // and the rows changed since, so that the next one copies the others.
+  std::vector<int> matrix_slots;
+  double matrix_diagonal = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Index matrix_entries = -1;
+  std::vector<char> changed_since_matrix;
   std::size_t recomputed = 0;
 
   State(SensedSpaceModel m, double d, const RegionParameters& p) : model(m), delta(d), params(p), grid(p.cell_size) {}
@@ -119,6 +126,8 @@ struct IncrementalOverlap::State {
   void markChanged(int slot) {
     if (slot >= int(changed.size())) changed.resize(slots.size(), 0);
     changed[slot] = 1;
+    if (slot >= int(changed_since_matrix.size())) changed_since_matrix.resize(slots.size(), 1);
+    changed_since_matrix[slot] = 1;
   }
   /// Every pair that changes has a source at one end: a slot given new
   /// points, or whose region now holds other cells.
@@ -483,8 +492,10 @@ std::size_t IncrementalOverlap::regionCells(int slot) const {
 }
 std::size_t IncrementalOverlap::recomputedLastUpdate() const { return state_->recomputed; }
 
-WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const {
-  const State& s = *state_;
+WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const { return weightMatrix(diagonal, nullptr); }
+
+WeightMatrix IncrementalOverlap::weightMatrix(double diagonal, const WeightMatrix* previous) const {
+  State& s = *state_;
   if (!std::isfinite(diagonal) || diagonal < 0.0)
     throw std::invalid_argument("buildWeightMatrix: diagonal weight must be finite and >= 0");
   const std::vector<int> present = slots();
@@ -493,6 +504,15 @@ WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const {
   const bool points = s.model == SensedSpaceModel::Points;
   const auto size = [&](int i) { return double(points ? s.slots[i].points.size() : s.slots[i].region.size()); };
   const Eigen::Index n = Eigen::Index(present.size());
+  // The previous matrix's column of a row unchanged since is this one's
+  // when every slot it held keeps its position (observations appended, as a
+  // robot adds them): the row's pairs, and the sizes of both ends of each,
+  // are as they were, or the row would have been marked changed.
+  const Eigen::Index kept = Eigen::Index(s.matrix_slots.size());
+  const bool copy = previous && diagonal == s.matrix_diagonal && previous->rows() == kept &&
+                    previous->cols() == kept && previous->nonZeros() == s.matrix_entries && kept <= n &&
+                    std::equal(s.matrix_slots.begin(), s.matrix_slots.end(), present.begin());
+  s.changed_since_matrix.resize(s.slots.size(), 1);
   std::size_t entries = 0;
   for (int i : present) entries += s.slots[i].row.size();
   WeightMatrix W(n, n);
@@ -500,6 +520,10 @@ WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const {
   for (Eigen::Index k = 0; k < n; ++k) {
     const int i = present[k];
     W.startVec(k);
+    if (copy && k < kept && !s.changed_since_matrix[i]) {
+      for (WeightMatrix::InnerIterator it(*previous, k); it; ++it) W.insertBack(it.row(), k) = it.value();
+      continue;
+    }
     bool diagonal_done = diagonal == 0.0;
     for (const PairCounts& p : s.slots[i].row) {
       if (!diagonal_done && p.j > i) {
@@ -514,6 +538,10 @@ WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const {
     if (!diagonal_done) W.insertBack(k, k) = diagonal;
   }
   W.finalize();
+  s.matrix_slots = present;
+  s.matrix_diagonal = diagonal;
+  s.matrix_entries = W.nonZeros();
+  std::fill(s.changed_since_matrix.begin(), s.changed_since_matrix.end(), 0);
   return W;
 }
 

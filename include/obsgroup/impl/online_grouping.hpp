@@ -174,7 +174,7 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   const std::vector<int> changed_slots = overlap_->update(params_.threads, interrupt_);
   out.observations_recomputed = overlap_->recomputedLastUpdate();
   const std::vector<int> ids = overlap_->slots();
-  W_ = overlap_->weightMatrix(params_.diagonal_weight);
+  W_ = overlap_->weightMatrix(params_.diagonal_weight, &W_);  // the unchanged columns copied
   pending_.resize(slots_.size(), 0);
   for (int slot : changed_slots) pending_[slot] = 1;
   pending_sources_.resize(slots_.size(), 0);

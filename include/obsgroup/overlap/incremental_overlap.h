@@ -66,6 +66,12 @@ class IncrementalOverlap {
   std::vector<int> slots() const;
   /// W over slots() with the given diagonal (as buildWeightMatrix).
   WeightMatrix weightMatrix(double diagonal) const;
+  /// The same W, with the columns of the rows unchanged since `previous`
+  /// was built copied from it rather than computed again: `previous` must
+  /// be the matrix the last weightMatrix() call returned (it is not used
+  /// when its size, entry count or diagonal say otherwise, or when a slot it
+  /// held moved to another position, as after a removal).
+  WeightMatrix weightMatrix(double diagonal, const WeightMatrix* previous) const;
   /// Points of a slot (M of eq. 17 for points); cells of its region for the
   /// region models.
   std::size_t pointCount(int slot) const;
