@@ -161,9 +161,10 @@ class RegionMarker {
 /// One segment's walk through the plane's cells (Amanatides and Woo), held
 /// as a state so that walks can advance in turn (traversePair): the plane's
 /// walk is the inner loop of every view and of the occupancy evidence, and
-/// each step waits on the one before it. The axis is chosen by selects rather
-/// than a branch the processor cannot predict (a ray's x and y steps
-/// alternate); adding 0.0 to the axis not taken leaves it to the bit.
+/// each step waits on the one before it. Adding 0.0 to the axis not taken
+/// leaves it to the bit. (The compiler turns the selects into branches; a
+/// form without branches, the step masked by bits, took the evidence of
+/// 360-beam scans from 0.059 to 0.077 ms a scan in a micro-benchmark.)
 class PlaneWalk {
  public:
   PlaneWalk(const std::array<double, 2>& from, const std::array<double, 2>& to) {

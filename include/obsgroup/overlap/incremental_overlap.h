@@ -70,7 +70,8 @@ class IncrementalOverlap {
   /// was built copied from it rather than computed again: `previous` must
   /// be the matrix the last weightMatrix() call returned (it is not used
   /// when its size, entry count or diagonal say otherwise, or when a slot it
-  /// held moved to another position, as after a removal).
+  /// held moved to another position, as after a removal). Both overloads
+  /// note what they built for the next call: not from two threads at once.
   WeightMatrix weightMatrix(double diagonal, const WeightMatrix* previous) const;
   /// Points of a slot (M of eq. 17 for points); cells of its region for the
   /// region models.
