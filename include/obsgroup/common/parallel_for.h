@@ -35,6 +35,17 @@ inline int threadCount(int threads) {
 /// the exception of the smallest failing index.
 template <typename MakeScratch, typename Body>
 void parallelForWithScratch(std::size_t n, int threads, int chunk, MakeScratch&& make_scratch, Body&& body) {
+  // A loop of one chunk or less runs here, without an OpenMP team: the
+  // online grouping runs thousands of such loops (a level of the split tree
+  // with one node, a few regions to recompute), and each team's start and
+  // end hands work between threads that then spin or sleep in between
+  // (docs/performance.md, "Beside other work").
+  if (n <= std::size_t(std::max(chunk, 1)) || threadCount(threads) == 1) {
+    if (n == 0) return;
+    auto scratch = make_scratch();
+    for (std::size_t i = 0; i < n; ++i) body(i, scratch);  // the first failure is the smallest index
+    return;
+  }
   std::exception_ptr first, scratch_failed;
   // Indices after a failed one are skipped: they cannot change which
   // exception is rethrown, and a failing callback should not be called on.
