@@ -40,22 +40,46 @@ void catchInterrupts() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
-/// A large run writes gigabytes of freshly mapped memory, and on 4 KiB pages
-/// the page faults cost about a quarter of it (100,100 scans: 1.4 million
-/// faults, 12 s of system time of a 36 s run; docs/performance.md). glibc
-/// backs its heap with transparent huge pages only when asked at start-up
-/// (the glibc.malloc.hugetlb tunable), so the command starts itself again
-/// once with it, where the kernel gives huge pages on request. A user who set
-/// GLIBC_TUNABLES (even empty) keeps their own settings.
-void preferTransparentHugePages(char** argv) {
-#if defined(__linux__) && defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
-  if (std::getenv("GLIBC_TUNABLES") != nullptr) return;
+/// Settings the C and OpenMP runtimes read once, when the program is loaded,
+/// so the command sets them by starting itself again, once, with them in
+/// its environment. A setting the user gave (even empty) is theirs and kept.
+///
+/// - GLIBC_TUNABLES=glibc.malloc.hugetlb=1, where the kernel gives
+///   transparent huge pages on request: a large run writes gigabytes of
+///   freshly mapped memory, and on 4 KiB pages the page faults cost about a
+///   quarter of it (100,100 scans: 1.4 million faults, 12 s of system time
+///   of a 36 s run; docs/performance.md). glibc backs its heap with huge
+///   pages only when asked at start-up.
+/// - OMP_WAIT_POLICY=passive: by default an idle OpenMP thread spins, waiting
+///   for the next parallel loop. `stream` runs thousands of small loops, and
+///   on a machine whose cores are busy with other work (a robot's, always)
+///   the spinning threads take the cores the working ones wait for: the
+///   1,001-scan stream took 68-71 s instead of 10-11 s beside one busy
+///   process on 2 cores (docs/performance.md). Sleeping threads cost the
+///   batch run nothing measurable.
+void startWithRuntimeSettings(char** argv) {
+#if defined(__linux__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  bool changed = false;
+  const auto setIfUnset = [&changed](const char* name, const char* value) {
+    if (std::getenv(name) != nullptr) return false;
+    if (setenv(name, value, 0) != 0) return false;
+    changed = true;
+    return true;
+  };
+  bool tunables_set = false;
+#if defined(__GLIBC__)
   std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string modes;
-  if (!std::getline(mode, modes) || modes.find("[madvise]") == std::string::npos) return;  // "always": already; "never": no use
-  if (setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1", 0) != 0) return;
+  // "always": huge pages already; "never": no use.
+  if (std::getline(mode, modes) && modes.find("[madvise]") != std::string::npos)
+    tunables_set = setIfUnset("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1");
+#endif
+  const bool wait_set = setIfUnset("OMP_WAIT_POLICY", "passive");
+  if (!changed) return;
   execv("/proc/self/exe", argv);
-  unsetenv("GLIBC_TUNABLES");  // not started again: carry on as it is
+  // Not started again: carry on as it is.
+  if (tunables_set) unsetenv("GLIBC_TUNABLES");
+  if (wait_set) unsetenv("OMP_WAIT_POLICY");
 #else
   (void)argv;
 #endif
@@ -80,7 +104,7 @@ void padHeapGrowth() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  preferTransparentHugePages(argv);
+  startWithRuntimeSettings(argv);
   padHeapGrowth();
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // obsgroup words its own errors
 
