@@ -29,7 +29,14 @@ from typing import Any, Callable, Dict, Iterable, Iterator, List, NamedTuple, Op
 
 import numpy as np
 
-from . import _obsgroup
+# OpenMP reads this once, when its runtime loads with the extension below: idle threads then
+# sleep instead of spinning, which on a busy machine (a robot's, or a notebook beside other
+# work) take the cores the working threads wait for (the 1,001-scan stream: 26-30 s instead of
+# 11 s beside one busy process; docs/performance.md). A value of the user's own is kept; it has
+# no effect when another library loaded OpenMP's runtime first.
+os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
+from . import _obsgroup  # noqa: E402
 from ._obsgroup import InputError, LocalMap, Observation, UsageError
 
 __version__ = "0.1.0"

@@ -1,6 +1,9 @@
 """The online grouping ends with the batch's groups; local maps, places and the command from Python."""
 
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -103,3 +106,15 @@ def test_partition_reports_the_progress_of_every_stage(data, tmp_path):
     assert stages == ["read", "overlap", "local maps", "places", "pictures"]
     last = {stage: (done, total) for stage, done, total in steps}
     assert all(done == total for done, total in last.values())  # each stage ends complete
+
+
+
+@pytest.mark.parametrize("given, expected", [(None, "passive"), ("active", "active")])
+def test_openmp_threads_sleep_when_idle_unless_the_user_chose(given, expected):
+    # OpenMP reads it once, when the extension loads its runtime: the import sets it before that.
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    script = "import os, obsgroup; print(os.environ['OMP_WAIT_POLICY'])"
+    out = subprocess.run([sys.executable, "-c", script], env=env, check=True, capture_output=True, text=True)
+    assert out.stdout.strip() == expected
