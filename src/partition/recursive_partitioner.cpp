@@ -152,14 +152,20 @@ class Partitioner {
     while (!frontier.empty()) {
       throwIfInterrupted(options_.interrupt);
       std::vector<Decision> decisions(frontier.size());
+      // The previous run's decisions are copied here, and only the nodes left
+      // to solve are shared out: online, that is mostly one node a level,
+      // which then runs on this thread without an OpenMP team.
+      std::vector<std::size_t> to_solve;
+      for (std::size_t k = 0; k < frontier.size(); ++k)
+        if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k])) to_solve.push_back(k);
       // Each thread has its own scratch for inducedSubgraph; the first failing
       // node's exception is rethrown unchanged (an input error stays one).
       parallelForWithScratch(
-          frontier.size(), options_.threads, 1,
+          to_solve.size(), options_.threads, 1,
           [&] { return NodeScratch{std::vector<int>(n, -1), &workspaces_[std::size_t(threadIndex())]}; },
-          [&](std::size_t k, NodeScratch& scratch) {
-            if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k]))
-              decisions[k] = decide(out_.splits[frontier[k]], scratch);
+          [&](std::size_t j, NodeScratch& scratch) {
+            const std::size_t k = to_solve[j];
+            decisions[k] = decide(out_.splits[frontier[k]], scratch);
           });
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
