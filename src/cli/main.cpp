@@ -54,9 +54,10 @@ void catchInterrupts() {
 ///   for the next parallel loop. `stream` runs thousands of small loops, and
 ///   on a machine whose cores are busy with other work (a robot's, always)
 ///   the spinning threads take the cores the working ones wait for: the
-///   1,001-scan stream took 68-71 s instead of 10-11 s beside one busy
-///   process on 2 cores (docs/performance.md). Sleeping threads cost the
-///   batch run nothing measurable.
+///   1,001-scan stream took 26-30 s instead of 11 s beside one busy process
+///   on 2 cores (docs/performance.md, "Beside other work"). On a quiet
+///   machine sleeping threads cost the stream about a tenth, the batch run
+///   nothing measurable.
 void startWithRuntimeSettings(char** argv) {
 #if defined(__linux__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
   bool changed = false;

@@ -31,8 +31,9 @@ inline int threadCount(int threads) {
 
 /// Runs body(i, scratch) for i in [0, n) on threadCount(threads) threads,
 /// dynamically scheduled `chunk` indices at a time. Each thread gets its own
-/// scratch from make_scratch() (buffers reused across its indices). Rethrows
-/// the exception of the smallest failing index.
+/// scratch from make_scratch() (buffers reused across its indices); a loop of
+/// one chunk or less, or on one thread, runs in order on the calling thread
+/// with one scratch. Rethrows the exception of the smallest failing index.
 template <typename MakeScratch, typename Body>
 void parallelForWithScratch(std::size_t n, int threads, int chunk, MakeScratch&& make_scratch, Body&& body) {
   // A loop of one chunk or less runs here, without an OpenMP team: the
