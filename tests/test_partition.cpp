@@ -121,6 +121,25 @@ TEST(RecursivePartition, ThreadCountDoesNotChangeWOrThePartition) {
   expectWellFormed(a, 72);
 }
 
+TEST(RecursivePartition, ACallFromInsideTheCallersOwnThreadsGivesTheSamePartition) {
+  // A program may partition several graphs at once on its own OpenMP
+  // threads; the levels of one node then run on the caller's thread.
+  const auto obs = test::realLog();
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  const Partition expected = groupScans(grouping, obs);
+  const WeightMatrix& W = grouping.getWeightMatrix();
+  PartitionOptions options = grouping.getParameters().partitionOptions();
+  const Partition direct = recursivePartition(W, options);
+  ASSERT_EQ(direct.groups, expected.groups);
+  for (int threads : {1, 2}) {
+    options.threads = threads;
+    std::vector<Partition> inside(4);
+#pragma omp parallel for num_threads(4)
+    for (int k = 0; k < 4; ++k) inside[std::size_t(k)] = recursivePartition(W, options);
+    for (const Partition& p : inside) EXPECT_EQ(p.groups, expected.groups) << "threads " << threads;
+  }
+}
+
 namespace {
 
 /// The groups of a `{"observations": N, "groups": [[...], ...]}` file.

@@ -3,6 +3,7 @@
 #include "obsgroup/common/parallel_for.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -109,15 +110,6 @@ std::vector<int> eliminationRanks(const WeightMatrix& W, const FiedlerOptions& e
   return eigen.elimination_rank;
 }
 
-/// The thread of the innermost OpenMP team running this (0 outside one).
-int threadIndex() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
-
 /// What each thread of a level of the split tree works with.
 struct NodeScratch {
   std::vector<int> local_of;     // inducedSubgraph's
@@ -158,11 +150,14 @@ class Partitioner {
       std::vector<std::size_t> to_solve;
       for (std::size_t k = 0; k < frontier.size(); ++k)
         if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k])) to_solve.push_back(k);
-      // Each thread has its own scratch for inducedSubgraph; the first failing
-      // node's exception is rethrown unchanged (an input error stays one).
+      // Each thread has its own scratch for inducedSubgraph and its own
+      // workspace, taken in turn (not by OpenMP's thread number: a level run
+      // on the calling thread may be inside a caller's own team); the first
+      // failing node's exception is rethrown unchanged (an input error stays one).
+      std::atomic<std::size_t> next_workspace{0};
       parallelForWithScratch(
           to_solve.size(), options_.threads, 1,
-          [&] { return NodeScratch{std::vector<int>(n, -1), &workspaces_[std::size_t(threadIndex())]}; },
+          [&] { return NodeScratch{std::vector<int>(n, -1), &workspaces_.at(next_workspace++)}; },
           [&](std::size_t j, NodeScratch& scratch) {
             const std::size_t k = to_solve[j];
             decisions[k] = decide(out_.splits[frontier[k]], scratch);
