@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <thread>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -574,14 +575,16 @@ CellMatches matchCells(const Grid& grid, double delta, int threads, const Progre
   const std::vector<Run>& runs = grid.runs();
   std::atomic<std::size_t> done{0};
   // The progress callback is the user's code: parallelFor hands its
-  // exception, as the interruption's, to the caller.
+  // exception, as the interruption's, to the caller. It is called on the
+  // calling thread (a small loop runs there, maybe inside a caller's team).
+  const std::thread::id caller = std::this_thread::get_id();
   parallelForWithScratch(
       cells, threads, 256, [&grid] { return NeighbourhoodScratch(grid.observations()); },
       [&](std::size_t c, NeighbourhoodScratch& scratch) {
         if (c % 256 == 0) {
           throwIfInterrupted(interrupt);
           const std::size_t now = done += 256;
-          if (progress && omp_get_thread_num() == 0) progress(std::min(now, cells), progress_total);
+          if (progress && std::this_thread::get_id() == caller) progress(std::min(now, cells), progress_total);
         }
         const std::uint32_t groups = groupNeighbourhood(grid, c, out.near.data() + out.near_offsets[c], scratch);
         const std::size_t words = out.words(c);
@@ -671,6 +674,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
   throwIfInterrupted(interrupt);
   std::vector<std::uint64_t> row_pairs(n, 0);
   std::atomic<std::size_t> done{0};
+  const std::thread::id caller = std::this_thread::get_id();
   parallelForWithScratch(
       std::size_t(n), nthreads, 16, [n] { return RowScratch(n); },
       [&](std::size_t i, RowScratch& scratch) {
@@ -679,7 +683,7 @@ MatchCounts countMatchesSharedGrid(const WorldPoints& world, double delta, int t
         countRow(grid, matches, int(i), scratch, out.rows[i]);
         row_pairs[i] = scratch.pairs - before;
         const std::size_t now = ++done;
-        if (report && omp_get_thread_num() == 0) report(grid.cells() + now, progress_total);
+        if (report && std::this_thread::get_id() == caller) report(grid.cells() + now, progress_total);
       });
   std::uint64_t pairs = 0;
   for (const std::uint64_t p : row_pairs) pairs += p;

@@ -19,6 +19,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace obsgroup {
 
@@ -158,6 +159,7 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
   // each thread owns a kd-tree. The search object and the progress callback
   // are the user's code: parallelFor hands their exceptions to the caller.
   const int threads = search_ ? 1 : threadCount(threads_);
+  const std::thread::id caller = std::this_thread::get_id();  // progress on the calling thread
   parallelForWithScratch(
       std::size_t(n), threads, 4,
       [this] { return search_ ? search_ : SearchMethodPtr(new pcl::search::KdTree<PointT>(false)); },
@@ -166,7 +168,7 @@ MatchCounts SensedSpaceOverlap<PointT>::countMatchesPclSearch(const WorldPoints&
         if (!candidates[j].empty())
           columns[j] = detail::countColumnPclSearch(*search, world, int(j), candidates[j], delta_, column_tests[j]);
         const std::size_t now = ++done;
-        if (progress_ && omp_get_thread_num() == 0) progress_(now, n);
+        if (progress_ && std::this_thread::get_id() == caller) progress_(now, n);
       });
   std::uint64_t pairs = 0, tests = 0;
   for (int j = 0; j < n; ++j) {
