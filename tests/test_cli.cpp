@@ -1115,6 +1115,19 @@ TEST_F(Cli, RunsAreByteIdenticalApartFromTimings) {
   ASSERT_EQ(run("partition " + input + " -q -o " + (dir_ / "b").string(), "GLIBC_TUNABLES= OMP_WAIT_POLICY=active").code,
             0);
   auto a = snapshot(dir_ / "a"), b = snapshot(dir_ / "b");
+  // How long OpenMP's idle threads spin, as read when the process that ran was loaded (the last of
+  // its reports; "0": they sleep at once, which an unset OMP_WAIT_POLICY also reports as PASSIVE).
+  const auto spinning = [this, &input](const std::string& environment) {
+    const std::string err = run("partition " + input + " -q --no-pictures --force -o " + (dir_ / "c").string(),
+                                "OMP_DISPLAY_ENV=verbose " + environment).err;
+    const std::size_t at = err.rfind("GOMP_SPINCOUNT = ");
+    return at == std::string::npos ? std::string("no report") : err.substr(at, err.find('\n', at) - at);
+  };
+#if defined(_OPENMP) && defined(__linux__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  EXPECT_EQ(spinning(""), "GOMP_SPINCOUNT = '0'");
+  EXPECT_NE(spinning("OMP_WAIT_POLICY=active"), "GOMP_SPINCOUNT = '0'");
+  EXPECT_NE(spinning("OMP_WAIT_POLICY=active"), "no report");
+#endif
   const auto strip = [](std::string text) { return text.substr(0, text.find("\"timing_s\"")); };
   a["partition.json"] = strip(a["partition.json"]);
   b["partition.json"] = strip(b["partition.json"]);

@@ -56,10 +56,16 @@ void catchInterrupts() {
 ///   the spinning threads take the cores the working ones wait for: the
 ///   1,001-scan stream took 26-30 s instead of 11 s beside one busy process
 ///   on 2 cores (docs/performance.md, "Beside other work"). On a quiet
-///   machine sleeping threads cost the stream about a tenth, the batch run
-///   nothing measurable.
+///   machine sleeping threads cost the stream a tenth to a half (10-13 s
+///   against 9 s), the batch runs nothing measurable.
 void startWithRuntimeSettings(char** argv) {
 #if defined(__linux__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  // Started again already: never a second time (a setuid program, say,
+  // whose loader drops GLIBC_TUNABLES), and nothing left for its children.
+  if (std::getenv("OBSGROUP_RESTARTED") != nullptr) {
+    unsetenv("OBSGROUP_RESTARTED");
+    return;
+  }
   bool changed = false;
   const auto setIfUnset = [&changed](const char* name, const char* value) {
     if (std::getenv(name) != nullptr) return false;
@@ -77,8 +83,9 @@ void startWithRuntimeSettings(char** argv) {
 #endif
   const bool wait_set = setIfUnset("OMP_WAIT_POLICY", "passive");
   if (!changed) return;
-  execv("/proc/self/exe", argv);
+  if (setenv("OBSGROUP_RESTARTED", "1", 1) == 0) execv("/proc/self/exe", argv);
   // Not started again: carry on as it is.
+  unsetenv("OBSGROUP_RESTARTED");
   if (tunables_set) unsetenv("GLIBC_TUNABLES");
   if (wait_set) unsetenv("OMP_WAIT_POLICY");
 #else
