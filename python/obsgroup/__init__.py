@@ -33,10 +33,17 @@ import numpy as np
 # sleep instead of spinning, which on a busy machine (a robot's, or a notebook beside other
 # work) take the cores the working threads wait for (the 1,001-scan stream: 26-30 s instead of
 # 11 s beside one busy process; docs/performance.md). A value of the user's own is kept; it has
-# no effect when another library loaded OpenMP's runtime first.
-os.environ.setdefault("OMP_WAIT_POLICY", "passive")
-
-from . import _obsgroup  # noqa: E402
+# no effect when another library loaded OpenMP's runtime first. Taken back once read, so that
+# the processes the user starts do not inherit it.
+_wait_policy_set = "OMP_WAIT_POLICY" not in os.environ
+if _wait_policy_set:
+    os.environ["OMP_WAIT_POLICY"] = "passive"
+try:
+    from . import _obsgroup  # noqa: E402
+finally:
+    if _wait_policy_set:
+        del os.environ["OMP_WAIT_POLICY"]
+del _wait_policy_set
 from ._obsgroup import InputError, LocalMap, Observation, UsageError
 
 __version__ = "0.1.0"

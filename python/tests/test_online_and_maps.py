@@ -109,12 +109,18 @@ def test_partition_reports_the_progress_of_every_stage(data, tmp_path):
 
 
 
-@pytest.mark.parametrize("given, expected", [(None, "passive"), ("active", "active")])
-def test_openmp_threads_sleep_when_idle_unless_the_user_chose(given, expected):
-    # OpenMP reads it once, when the extension loads its runtime: the import sets it before that.
+@pytest.mark.parametrize("given, sleeps", [(None, True), ("active", False)])
+def test_openmp_threads_sleep_when_idle_unless_the_user_chose(given, sleeps):
+    # How long idle threads spin, as OpenMP read it when the extension loaded its runtime
+    # (OMP_DISPLAY_ENV=verbose, on standard error; "0": they sleep at once), and the environment
+    # handed to the user's own processes left as it was.
     env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    env["OMP_DISPLAY_ENV"] = "verbose"
     if given is not None:
         env["OMP_WAIT_POLICY"] = given
-    script = "import os, obsgroup; print(os.environ['OMP_WAIT_POLICY'])"
+    script = "import os, obsgroup; print(os.environ.get('OMP_WAIT_POLICY'))"
     out = subprocess.run([sys.executable, "-c", script], env=env, check=True, capture_output=True, text=True)
-    assert out.stdout.strip() == expected
+    spins = [line.strip() for line in out.stderr.splitlines() if "GOMP_SPINCOUNT = " in line]
+    assert spins, out.stderr
+    assert (spins[-1] == "GOMP_SPINCOUNT = '0'") == sleeps
+    assert out.stdout.strip() == str(given)
