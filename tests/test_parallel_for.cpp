@@ -19,9 +19,10 @@ using namespace obsgroup;
 
 namespace {
 
+/// Inside a parallel region, even a team of one thread (which omp_in_parallel does not count).
 bool inTeam() {
 #ifdef _OPENMP
-  return omp_in_parallel() != 0;
+  return omp_get_level() > 0;
 #else
   return false;
 #endif
