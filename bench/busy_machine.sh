@@ -9,7 +9,9 @@
 # markdown table of the median wall time of REPEATS runs, and checks that every
 # run wrote the same partition.json (timings aside).
 #
-#   bench/busy_machine.sh [--output docs/performance.md] [REPEATS=3]
+#   bench/busy_machine.sh [--output docs/performance.md] [REPEATS]
+#
+# REPEATS: runs of each cell (3 when not given).
 #
 # With --output the table replaces the lines between "<!-- busy:begin -->"
 # and "<!-- busy:end -->" of that file. About 15 minutes on 2 cores.
@@ -19,7 +21,7 @@ output=""
 while [ $# -gt 0 ]; do
   case $1 in
     --output) output=$2; shift 2 ;;
-    -h|--help) sed -n 2,15p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,17p "$0"; exit 0 ;;
     *) break ;;
   esac
 done
@@ -33,8 +35,9 @@ for n in 1001 10010 100100; do
   [ -f "$work/building_$n.clf" ] || build/bench/make_scaling_input 2d "$n" "$work/building_$n.clf" > /dev/null
 done
 table=$(mktemp)
+trap 'rm -f "$table"' EXIT
 {
-echo "Machine: $(nproc) cores; $(date -u +%Y-%m-%d); commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)."
+echo "Machine: $(nproc) cores; $(date -u +%Y-%m-%d); commit $(git describe --always --dirty 2>/dev/null || echo unknown)."
 echo
 python3 - "$work" "$repeats" <<'PY'
 import json, os, signal, statistics, subprocess, sys, time
@@ -63,7 +66,8 @@ for label, words in jobs:
                     out = os.path.join(work, "busy_out")
                     subprocess.run(["rm", "-rf", out], check=True)
                     start = time.perf_counter()
-                    subprocess.run([exe, *words, "--output", out, "-q", "--no-pictures"], env=env, check=True)
+                    subprocess.run([exe, *words, "--output", out, "-q", "--no-pictures"], env=env, check=True,
+                                   stdout=subprocess.DEVNULL)
                     walls.append(time.perf_counter() - start)
                     d = json.load(open(os.path.join(out, "partition.json")))
                     d.pop("timing_s", None)
@@ -82,4 +86,3 @@ if [ -z "$output" ]; then
 else
   python3 bench/replace_section.py "$output" busy "$table"
 fi
-rm -f "$table"
