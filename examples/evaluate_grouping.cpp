@@ -186,6 +186,9 @@ struct Configuration {
   int min_group_size = 1;
   double ncut_threshold = GroupingParameters{}.ncut_threshold;
   int boundary_passes = GroupingParameters{}.boundary_passes;
+  /// GroupingParameters::mutual_neighbours (a count, swept as a number).
+  double mutual_neighbours = GroupingParameters{}.mutual_neighbours;
+  double mutual_neighbours_share = GroupingParameters{}.mutual_neighbours_share;
   int threads = 0;  ///< 0: all cores
   /// Voxel leaf of each observation (0: every point); the command reduces
   /// dense frames at io::kDefaultFrameVoxel with the same pcl::VoxelGrid in
@@ -198,22 +201,28 @@ struct Configuration {
     const std::string delta = model == SensedSpaceModel::Points ? format(" δ %g m", match_distance) : std::string();
     const auto same_method = [this](const GroupingParameters& p) {
       return model == p.model && split == p.split && ncut_threshold == p.ncut_threshold &&
-             boundary_passes == p.boundary_passes;
+             boundary_passes == p.boundary_passes && mutual_neighbours == p.mutual_neighbours &&
+             mutual_neighbours_share == p.mutual_neighbours_share;
     };
     const bool paper = same_method(GroupingParameters::paper());
     const bool library_default = same_method(GroupingParameters{});
     return toString(model) + delta + ", split " + toString(split) + format(", Ncut < %g", ncut_threshold) +
            (boundary_passes > 0 ? format(", %d boundary passes", boundary_passes) : std::string()) +
+           (mutual_neighbours > 0 || mutual_neighbours_share > 0
+                ? format(", mutual neighbours %g / %g of the median", mutual_neighbours, mutual_neighbours_share)
+                : std::string()) +
            (paper ? " (the paper)" : "") + (library_default ? " (**the default**)" : "");
   }
 
   /// Every parameter, for the summary line of a sweep.
   std::string parameters() const {
     return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
-                  "door-width=%g door-depth=%g min-group-size=%d ncut-threshold=%g boundary-passes=%d",
+                  "door-width=%g door-depth=%g min-group-size=%d ncut-threshold=%g boundary-passes=%d "
+                  "mutual-neighbours=%g mutual-neighbours-share=%g",
                   toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
                   region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
-                  region.door_width, region.door_depth, min_group_size, ncut_threshold, boundary_passes);
+                  region.door_width, region.door_depth, min_group_size, ncut_threshold, boundary_passes,
+                  mutual_neighbours, mutual_neighbours_share);
   }
 };
 
@@ -248,6 +257,8 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
   params.min_group_size = c.min_group_size;
   params.ncut_threshold = c.ncut_threshold;
   params.boundary_passes = c.boundary_passes;
+  params.mutual_neighbours = int(std::lround(c.mutual_neighbours));
+  params.mutual_neighbours_share = c.mutual_neighbours_share;
   params.threads = c.threads;
   params.voxel_leaf = c.voxel_leaf;
   grouping.setParameters(params);
@@ -508,6 +519,8 @@ std::string sweepTable(const std::vector<Dataset>& datasets, const std::vector<L
       {"clearance (m)", [](Configuration& c) -> double& { return c.region.clearance; }},
       {"door width (m)", [](Configuration& c) -> double& { return c.region.door_width; }},
       {"door depth (m)", [](Configuration& c) -> double& { return c.region.door_depth; }},
+      {"mutual neighbours", [](Configuration& c) -> double& { return c.mutual_neighbours; }},
+      {"mutual neighbours' share of the median", [](Configuration& c) -> double& { return c.mutual_neighbours_share; }},
   };
   const SweepPoint reference = sweepPoint(datasets, logs, base);
   const auto change = [](int value, int of) {
@@ -531,6 +544,7 @@ std::string sweepTable(const std::vector<Dataset>& datasets, const std::vector<L
       Configuration c = base;
       double& value = parameter.value(c);
       value *= factor;
+      if (&value == &c.mutual_neighbours) value = std::round(value);  // a count
       std::cerr << parameter.name << " " << value << "\n";
       out << row(parameter.name, format("%g", value), sweepPoint(datasets, logs, c));
     }
@@ -644,12 +658,13 @@ int parseInteger(const std::string& flag, const std::string& text) {
 const char* kUsage =
     "usage: evaluate_grouping [--output FILE] [parameters] [selection]\n"
     "       evaluate_grouping --model M [--split S] [parameters] [selection]\n"
-    "Without --model: the page's thirteen configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's; the default without boundary refinement).\n"
+    "Without --model: the page's fourteen configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's; the default without boundary refinement; the default with every overlap, no mutual neighbours).\n"
     "With --model or --split: that one configuration (unset: the library's default), a line per dataset and a summary line.\n"
     "parameters (defaults: the library's):\n"
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --door-width M  --door-depth M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
+    "  --mutual-neighbours N  --mutual-neighbours-share X\n"
     "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
     "selection (defaults: all):\n"
@@ -700,6 +715,8 @@ int main(int argc, char** argv) {
         {"--min-group-size", integer(configuration.min_group_size)},
         {"--ncut-threshold", number(configuration.ncut_threshold)},
         {"--boundary-passes", integer(configuration.boundary_passes)},
+        {"--mutual-neighbours", number(configuration.mutual_neighbours)},
+        {"--mutual-neighbours-share", number(configuration.mutual_neighbours_share)},
         {"--threads", integer(configuration.threads)},
         {"--voxel", number(configuration.voxel_leaf)},
         {"--depth-size",
@@ -811,9 +828,12 @@ int main(int argc, char** argv) {
         c.model = m;
         c.split = s;
         c.ncut_threshold = threshold;
-        // The paper's row is the paper's method: no boundary refinement.
-        if (m == SensedSpaceModel::Points && s == SplitCriterion::Mean && threshold == 1.0)
+        // The paper's row is the paper's method: no boundary refinement, every overlap.
+        if (m == SensedSpaceModel::Points && s == SplitCriterion::Mean && threshold == 1.0) {
           c.boundary_passes = 0;
+          c.mutual_neighbours = 0;
+          c.mutual_neighbours_share = 0;
+        }
         configurations.push_back(c);
       }
   // The default without the boundary refinement, to show what it changes.
@@ -824,6 +844,12 @@ int main(int argc, char** argv) {
   unrefined.ncut_threshold = defaults.ncut_threshold;
   unrefined.boundary_passes = 0;
   configurations.push_back(unrefined);
+  // The default on W itself, every overlap kept: what the mutual neighbours change.
+  Configuration every_overlap = unrefined;
+  every_overlap.boundary_passes = defaults.boundary_passes;
+  every_overlap.mutual_neighbours = 0;
+  every_overlap.mutual_neighbours_share = 0;
+  configurations.push_back(every_overlap);
   const std::string report = page(datasets, configurations, generation_seconds);
   if (output.empty()) {
     std::cout << report;

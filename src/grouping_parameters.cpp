@@ -52,6 +52,8 @@ void GroupingParameters::usePaperMethod() {
   split = papers.split;
   ncut_threshold = papers.ncut_threshold;
   boundary_passes = papers.boundary_passes;
+  mutual_neighbours = papers.mutual_neighbours;
+  mutual_neighbours_share = papers.mutual_neighbours_share;
 }
 
 void GroupingParameters::check() const {
@@ -83,6 +85,12 @@ void GroupingParameters::check() const {
   require(std::isfinite(ncut_threshold) && ncut_threshold >= 0,
           "ncut_threshold must be finite and >= 0 (got " + number(ncut_threshold) + ")");
   require(boundary_passes >= 0, "boundary_passes must be >= 0 (got " + std::to_string(boundary_passes) + ")");
+  require(mutual_neighbours >= 0, "mutual_neighbours must be >= 0 (got " + std::to_string(mutual_neighbours) + ")");
+  require(std::isfinite(mutual_neighbours_share) && mutual_neighbours_share >= 0,
+          "mutual_neighbours_share must be finite and >= 0 (got " + number(mutual_neighbours_share) + ")");
+  require(mutual_neighbours > 0 || mutual_neighbours_share == 0 ||
+              mutual_neighbours_share == defaults.mutual_neighbours_share,
+          "mutual_neighbours_share applies when mutual_neighbours is above 0");
   require(min_group_size >= 1, "min_group_size must be >= 1 (got " + std::to_string(min_group_size) + ")");
   require(max_depth >= 0, "max_depth must be >= 0 (got " + std::to_string(max_depth) + ")");
   require(threads >= 0, "threads must be >= 0 (got " + std::to_string(threads) + ")");
@@ -95,6 +103,8 @@ PartitionOptions GroupingParameters::partitionOptions() const {
   options.min_group_size = min_group_size;
   options.max_depth = max_depth;
   options.boundary_passes = boundary_passes;
+  options.mutual_neighbours = mutual_neighbours;
+  options.mutual_neighbours_share = mutual_neighbours_share;
   options.eigen.solver = eigen_solver;
   options.threads = threads;
   return options;
@@ -104,7 +114,8 @@ bool operator==(const GroupingParameters& a, const GroupingParameters& b) {
   return a.model == b.model && a.regions == b.regions && a.match_distance == b.match_distance &&
          a.neighbour_search == b.neighbour_search && a.voxel_leaf == b.voxel_leaf &&
          a.diagonal_weight == b.diagonal_weight && a.split == b.split && a.ncut_threshold == b.ncut_threshold &&
-         a.boundary_passes == b.boundary_passes && a.min_group_size == b.min_group_size &&
+         a.boundary_passes == b.boundary_passes && a.mutual_neighbours == b.mutual_neighbours &&
+         a.mutual_neighbours_share == b.mutual_neighbours_share && a.min_group_size == b.min_group_size &&
          a.max_depth == b.max_depth && a.eigen_solver == b.eigen_solver && a.threads == b.threads;
 }
 

@@ -51,3 +51,37 @@ TEST(ObservationGraph, InducedSubgraphKeepsInternalEdgesOnly) {
   EXPECT_DOUBLE_EQ(S.coeff(2, 1), 0.3);
   EXPECT_DOUBLE_EQ(S.coeff(0, 2), 0.0);
 }
+
+TEST(ObservationGraph, MutualNeighboursKeepAnEdgeOnlyWhenBothEndsRankItAmongTheirStrongest) {
+  // Node 0 overlaps 1 and 2 most; node 3 overlaps 0 weakly, but for 0 it
+  // is its third: with k = 2 the edge 0-3 goes, whatever 3 thinks of it.
+  const WeightMatrix W =
+      buildWeightMatrix(5, {{0, 1, 0.9}, {0, 2, 0.8}, {0, 3, 0.3}, {1, 2, 0.7}, {3, 4, 0.6}}, 1.0);
+  const std::vector<double> thresholds = neighbourThresholds(W, 2);
+  EXPECT_DOUBLE_EQ(thresholds[0], 0.8);  // its 2nd strongest edge; the diagonal not counted
+  EXPECT_DOUBLE_EQ(thresholds[1], 0.0);  // two edges: all kept
+  EXPECT_DOUBLE_EQ(thresholds[4], 0.0);
+  const WeightMatrix M = mutualNeighbourGraph(W, thresholds);
+  EXPECT_DOUBLE_EQ(M.coeff(0, 1), 0.9);
+  EXPECT_DOUBLE_EQ(M.coeff(2, 0), 0.8);
+  EXPECT_DOUBLE_EQ(M.coeff(0, 3), 0.0);
+  EXPECT_DOUBLE_EQ(M.coeff(3, 0), 0.0);
+  EXPECT_DOUBLE_EQ(M.coeff(3, 4), 0.6);
+  for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(M.coeff(i, i), 1.0);  // the diagonal stays
+  EXPECT_EQ(M.nonZeros(), 2 * 4 + 5);
+  // Ties at the threshold are all kept.
+  const WeightMatrix T = buildWeightMatrix(4, {{0, 1, 0.5}, {0, 2, 0.5}, {0, 3, 0.5}});
+  EXPECT_EQ(mutualNeighbourGraph(T, neighbourThresholds(T, 1)).nonZeros(), 6);
+  EXPECT_THROW(mutualNeighbourGraph(W, {0.0}), std::invalid_argument);
+}
+
+TEST(ObservationGraph, MutualNeighbourCountGrowsWithTheMedianNumberOfNeighbours) {
+  // A path of 9 nodes: 2 neighbours each but the ends (median 2).
+  std::vector<WeightedPair> path;
+  for (int i = 0; i + 1 < 9; ++i) path.push_back({i, i + 1, 1.0});
+  const WeightMatrix W = buildWeightMatrix(9, path, 1.0);
+  EXPECT_EQ(mutualNeighbourCount(W, 1, 0.0), 1);
+  EXPECT_EQ(mutualNeighbourCount(W, 1, 2.0), 4);  // 2.0 x 2
+  EXPECT_EQ(mutualNeighbourCount(W, 5, 2.0), 5);
+  EXPECT_EQ(mutualNeighbourCount(WeightMatrix(0, 0), 3, 1.0), 3);
+}

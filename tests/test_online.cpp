@@ -166,6 +166,33 @@ TEST(OnlineGrouping, PaperMethodEqualsBatch) {
   expectEqualsBatch(online, batch, "paper");
 }
 
+TEST(OnlineGrouping, FewMutualNeighboursEqualBatchAfterEveryInsert) {
+  // With k this small every row of W is cut to its nearest neighbours, and
+  // k itself grows with the median as the map does: an insert then moves
+  // the thresholds of rows it adds no entry to, whose nodes must be solved
+  // again for the groups to stay the batch's.
+  GroupingParameters params;
+  params.mutual_neighbours = 4;
+  params.mutual_neighbours_share = 0.25;
+  const auto obs = driftedOffice();
+  OnlineGrouping<pcl::PointXYZ> online;
+  online.setParameters(params);
+  ObservationGrouping<pcl::PointXYZ> batch;
+  batch.setParameters(params);
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    online.insert(obs[k].cloud, obs[k].pose);
+    online.update();
+    expectEqualsBatch(online, batch, "insert " + std::to_string(k));
+  }
+  // The mutual neighbours changed the groups here, so the check above had something to check.
+  ObservationGrouping<pcl::PointXYZ> every_overlap;
+  params.mutual_neighbours = 0;
+  params.mutual_neighbours_share = 0.0;
+  every_overlap.setParameters(params);
+  for (const auto& o : obs) every_overlap.addObservation(o.cloud, o.pose);
+  EXPECT_NE(every_overlap.compute().groups, online.getPartition().groups);
+}
+
 TEST(OnlineGrouping, ReportsChangesAndKeepsIdsOfUntouchedGroups) {
   const auto obs = driftedOffice();
   OnlineGrouping<pcl::PointXYZ> online;

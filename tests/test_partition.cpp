@@ -292,6 +292,71 @@ TEST(RecursivePartition, TheSplitCacheCopiesTheNodesThatHoldNoSourceOfAChange) {
   EXPECT_LT(by_sources.computedNodes(), by_rows.computedNodes());
 }
 
+TEST(RecursivePartition, MutualNeighboursSeparateASmallRoomFromACorridorDrivenManyTimes) {
+  // A corridor of 120 scans, each overlapping the 40 on either side (a
+  // corridor driven again and again), and a room of 8 scans looked into from
+  // it: each room scan overlaps its 7 mates strongly and 60 corridor scans
+  // a little, which adds up to more than the room's own. Cut from W, the
+  // room's Ncut is above the threshold and it stays with the corridor; no
+  // corridor scan counts a room scan among its 20 nearest, so on the
+  // mutual-neighbour graph the room stands alone.
+  std::vector<WeightedPair> pairs;
+  for (int i = 0; i < 120; ++i)
+    for (int j = i + 1; j <= std::min(119, i + 40); ++j) pairs.push_back({i, j, 0.9 - 0.02 * (j - i)});
+  for (int a = 120; a < 128; ++a) {
+    for (int b = a + 1; b < 128; ++b) pairs.push_back({a, b, 0.95});
+    for (int c = 30; c < 90; ++c) pairs.push_back({c, a, 0.35});
+  }
+  const WeightMatrix W = buildWeightMatrix(128, pairs);
+  const std::vector<int> room{120, 121, 122, 123, 124, 125, 126, 127};
+  const auto hasRoom = [&](const Partition& p) { return std::find(p.groups.begin(), p.groups.end(), room) != p.groups.end(); };
+  PartitionOptions options = GroupingParameters{}.partitionOptions();
+  options.mutual_neighbours = 0;
+  const Partition every_overlap = recursivePartition(W, options);
+  expectWellFormed(every_overlap, 128);
+  EXPECT_FALSE(hasRoom(every_overlap));
+  options.mutual_neighbours = 20;
+  options.mutual_neighbours_share = 0.0;
+  const Partition mutual = recursivePartition(W, options);
+  expectWellFormed(mutual, 128);
+  EXPECT_TRUE(hasRoom(mutual));
+  // The share of the median number of neighbours (80 here) raises k: at 0.5,
+  // k = 40, and the corridor scans still rank the room's below their 40.
+  options.mutual_neighbours_share = 0.5;
+  EXPECT_TRUE(hasRoom(recursivePartition(W, options)));
+  options.mutual_neighbours = -1;
+  EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
+}
+
+TEST(RecursivePartition, TheSplitCacheFollowsTheMutualNeighboursOfAGrowingGraph) {
+  // Appending nodes to a chain moves the neighbour thresholds of the nodes
+  // next to them (and k, with the median): a node whose threshold moved is
+  // solved again even where no entry of its row changed in W.
+  PartitionOptions options = GroupingParameters{}.partitionOptions();
+  options.mutual_neighbours = 3;
+  options.mutual_neighbours_share = 0.4;
+  SplitCache cache;
+  std::vector<WeightedPair> pairs;
+  for (int n = 2; n <= 60; ++n) {
+    const int added = n - 1;
+    for (int j = std::max(0, added - 8); j < added; ++j)
+      pairs.push_back({j, added, 0.9 - 0.05 * (added - j) + 0.01 * ((added * 7 + j) % 3)});
+    const WeightMatrix W = buildWeightMatrix(n, pairs);
+    std::vector<int> ids(n);
+    for (int i = 0; i < n; ++i) ids[i] = i;
+    std::vector<char> changed(n, 0), sources(n, 0);
+    for (int j = std::max(0, added - 8); j <= added; ++j) changed[j] = 1;
+    sources[added] = 1;
+    const Partition fresh = recursivePartition(W, options);
+    const Partition cached = recursivePartition(W, options, ids, changed, sources, cache);
+    ASSERT_EQ(cached.groups, fresh.groups) << n << " nodes";
+    ASSERT_EQ(cached.splits.size(), fresh.splits.size()) << n << " nodes";
+    for (std::size_t k = 0; k < fresh.splits.size(); ++k)
+      ASSERT_EQ(0, std::memcmp(&cached.splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << n << " nodes, node " << k;
+  }
+  EXPECT_GT(cache.reusedNodes(), 0u);
+}
+
 TEST(Keyframes, AFrameIsAKeyframeWhenItMovedOrTurnedEnoughSinceTheLast) {
   std::vector<Eigen::Isometry3d> poses;
   for (int k = 0; k < 8; ++k) poses.push_back(pose2D(0.04 * k, 0.0, 0.0));  // 4 cm a frame

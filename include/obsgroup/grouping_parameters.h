@@ -52,6 +52,15 @@ struct GroupingParameters {
   /// (PartitionOptions::boundary_passes): doorway scans join the room their
   /// overlap says.
   int boundary_passes = 3;
+  /// The partition works on W's mutual-neighbour graph, each observation
+  /// keeping its k strongest edges that are also among the other end's,
+  /// k = max(mutual_neighbours, mutual_neighbours_share x the median number
+  /// of neighbours) (PartitionOptions::mutual_neighbours): a small room
+  /// whose scans each overlap many scans of a corridor driven again and
+  /// again is no longer held to it. mutual_neighbours 0: W as it is (the
+  /// paper's), and the share is not used.
+  int mutual_neighbours = 60;
+  double mutual_neighbours_share = 0.4;
   /// A bisection giving a group smaller than this is rejected.
   int min_group_size = 1;
   /// Bisections deeper than this are not attempted.

@@ -631,6 +631,8 @@ PYBIND11_MODULE(_obsgroup, m) {
         d["split"] = toString(p.split);
         d["ncut_threshold"] = p.ncut_threshold;
         d["boundary_passes"] = p.boundary_passes;
+        d["mutual_neighbours"] = p.mutual_neighbours;
+        d["mutual_neighbours_share"] = p.mutual_neighbours_share;
         d["threads"] = p.threads;
         return d;
       });

@@ -193,7 +193,8 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_flag("--paper", args.paper,
                    "the paper's method exactly: --sso " + toString(paper.model) + " --split " + toString(paper.split) +
                        " --ncut-threshold " + number(paper.ncut_threshold) + " --boundary-passes " +
-                       std::to_string(paper.boundary_passes) + " (delta as given)")
+                       std::to_string(paper.boundary_passes) + " --mutual-neighbours " +
+                       std::to_string(paper.mutual_neighbours) + " (delta as given)")
       ->group("Sensed-space model");
   command.add_option("--cell", args.method.regions.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(finiteNumber(0.0, true))
@@ -248,6 +249,17 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                      "sweeps after the split tree moving each observation to the group it overlaps most on "
                      "average (0: none, the paper's)")
       ->check(CLI::Range(0, 100))
+      ->capture_default_str()
+      ->group("Partition");
+  command.add_option("--mutual-neighbours", args.method.mutual_neighbours,
+                     "partition the graph in which each observation keeps the K it overlaps most that also keep "
+                     "it (more on dense maps: --mutual-neighbours-share; 0: every overlap, the paper's)")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str()
+      ->group("Partition");
+  command.add_option("--mutual-neighbours-share", args.method.mutual_neighbours_share,
+                     "... or this share of the median number of observations each overlaps, when more")
+      ->check(finiteNumber(0.0, false, 10.0))
       ->capture_default_str()
       ->group("Partition");
   command.add_option("--split", args.method.split,
@@ -480,8 +492,13 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
       return "--paper uses --ncut-threshold " + number(paper.ncut_threshold) + "; drop one of them";
     if (partition.count("--boundary-passes") && args.method.boundary_passes != paper.boundary_passes)
       return "--paper uses --boundary-passes " + std::to_string(paper.boundary_passes) + "; drop one of them";
+    for (const char* option : {"--mutual-neighbours", "--mutual-neighbours-share"})
+      if (partition.count(option))
+        return std::string("--paper uses every overlap (--mutual-neighbours 0); drop ") + option;
     args.method.usePaperMethod();
   }
+  if (partition.count("--mutual-neighbours-share") && args.method.mutual_neighbours == 0)
+    return "--mutual-neighbours-share applies when --mutual-neighbours is above 0";
   // Options of one model given with another are a mistake, not a no-op.
   const bool points = args.method.model == SensedSpaceModel::Points;
   for (const char* option : {"--cell", "--range"})

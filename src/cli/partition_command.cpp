@@ -339,6 +339,8 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
   p["ncut_threshold"] = method.ncut_threshold;
   p["split"] = toString(method.split);
   p["boundary_passes"] = method.boundary_passes;
+  p["mutual_neighbours"] = method.mutual_neighbours;
+  p["mutual_neighbours_share"] = method.mutual_neighbours_share;
   p["min_group_size"] = method.min_group_size;
   p["max_depth"] = method.max_depth == GroupingParameters{}.max_depth ? nlohmann::json() : nlohmann::json(method.max_depth);
   p["diagonal"] = method.diagonal_weight;

@@ -1,6 +1,9 @@
 #include "obsgroup/graph/observation_graph.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -121,6 +124,70 @@ std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W) {
     std::sort(components[c].begin(), components[c].end());
   }
   return components;
+}
+
+int mutualNeighbourCount(const WeightMatrix& W, int at_least, double share) {
+  std::vector<Eigen::Index> counts(std::size_t(W.outerSize()));
+  for (Eigen::Index j = 0; j < W.outerSize(); ++j) {
+    Eigen::Index c = 0;
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
+      if (it.index() != j) ++c;
+    counts[std::size_t(j)] = c;
+  }
+  if (counts.empty()) return std::max(at_least, 0);
+  const auto middle = counts.begin() + std::ptrdiff_t(counts.size() / 2);
+  std::nth_element(counts.begin(), middle, counts.end());
+  const double from_median = std::round(share * double(*middle));
+  return std::max(at_least, int(std::min(from_median, double(std::numeric_limits<int>::max()))));
+}
+
+namespace {
+
+/// The k-th largest weight of node j's edges (the diagonal not counted), or
+/// 0 when it has k or fewer: the edges at or above it are the k strongest.
+double neighbourThreshold(const WeightMatrix& W, Eigen::Index j, int k, std::vector<double>& row) {
+  row.clear();
+  for (WeightMatrix::InnerIterator it(W, j); it; ++it)
+    if (it.index() != j) row.push_back(it.value());
+  if (k <= 0 || Eigen::Index(row.size()) <= k) return 0.0;
+  std::nth_element(row.begin(), row.begin() + (k - 1), row.end(), std::greater<>());
+  return row[std::size_t(k - 1)];
+}
+
+}  // namespace
+
+std::vector<double> neighbourThresholds(const WeightMatrix& W, int k) {
+  std::vector<double> thresholds(std::size_t(W.outerSize()), 0.0);
+  updateNeighbourThresholds(W, k, std::vector<char>(thresholds.size(), 1), thresholds);
+  return thresholds;
+}
+
+void updateNeighbourThresholds(const WeightMatrix& W, int k, const std::vector<char>& rows,
+                               std::vector<double>& thresholds) {
+  if (Eigen::Index(rows.size()) != W.outerSize() || Eigen::Index(thresholds.size()) != W.outerSize())
+    throw std::invalid_argument("updateNeighbourThresholds: one flag and one threshold per node expected");
+  std::vector<double> row;
+  for (Eigen::Index j = 0; j < W.outerSize(); ++j)
+    if (rows[std::size_t(j)]) thresholds[std::size_t(j)] = neighbourThreshold(W, j, k, row);
+}
+
+WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds) {
+  if (Eigen::Index(thresholds.size()) != W.outerSize())
+    throw std::invalid_argument("mutualNeighbourGraph: one threshold per node expected");
+  WeightMatrix kept(W.rows(), W.cols());
+  std::vector<int> sizes(std::size_t(W.outerSize()), 0);
+  const auto keep = [&thresholds](Eigen::Index i, Eigen::Index j, double w) {
+    return i == j || (w >= thresholds[std::size_t(i)] && w >= thresholds[std::size_t(j)]);
+  };
+  for (Eigen::Index j = 0; j < W.outerSize(); ++j)
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
+      if (keep(it.index(), j, it.value())) ++sizes[std::size_t(j)];
+  kept.reserve(sizes);
+  for (Eigen::Index j = 0; j < W.outerSize(); ++j)
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
+      if (keep(it.index(), j, it.value())) kept.insert(it.index(), j) = it.value();
+  kept.makeCompressed();
+  return kept;
 }
 
 }  // namespace obsgroup

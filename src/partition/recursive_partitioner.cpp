@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -77,6 +78,11 @@ struct SplitCache::Store {
   /// Filled by a run that checked every row of its W (checkWeights), or
   /// whose unchanged rows an earlier such run had checked.
   bool weights_checked = false;
+  /// The mutual-neighbour count of the run and each node's threshold, by
+  /// id (ascending): a node whose threshold moves is a source of the next.
+  int neighbour_count = 0;
+  std::vector<int> threshold_ids;
+  std::vector<double> thresholds;
 
   Entry* find(const std::vector<int>& member_ids, int depth) {
     const auto it = entries.find(nodeKey(member_ids, depth));
@@ -433,17 +439,81 @@ void refineBoundaries(const WeightMatrix& W, int passes, int min_size, Partition
   p.group_of = std::move(group_of);
 }
 
-}  // namespace
-
-Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options) {
-  if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
+void checkOptions(const PartitionOptions& options) {
   if (!(options.ncut_threshold >= 0.0))
     throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
   if (options.boundary_passes < 0)
     throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
+  if (options.mutual_neighbours < 0)
+    throw std::invalid_argument("recursivePartition: mutual_neighbours must be >= 0");
+  if (!(options.mutual_neighbours_share >= 0.0) || !std::isfinite(options.mutual_neighbours_share))
+    throw std::invalid_argument("recursivePartition: mutual_neighbours_share must be finite and >= 0");
+}
+
+/// The sources of the changes of the mutual-neighbour graph since the run
+/// `last` recorded: an entry kept or dropped changes when W_ij does (a
+/// source at one end, the caller's) or when the threshold of i or j moves,
+/// which an edge entering or leaving a row's k strongest does without a
+/// source. Each entry of W whose ends are no source and which the thresholds
+/// kept before but not now, or the reverse, makes one of its ends a source.
+/// Every node is one when k changed or the cache holds no run.
+std::vector<char> keptEntrySources(const WeightMatrix& W, const std::vector<char>& sources,
+                                   const std::vector<double>& before, const std::vector<double>& thresholds, int k,
+                                   const SplitCache::Store& last) {
+  std::vector<char> out = sources;
+  if (last.neighbour_count != k) return std::vector<char>(sources.size(), 1);
+  for (Eigen::Index j = 0; j < W.outerSize(); ++j) {
+    const auto sj = std::size_t(j);
+    if (out[sj] || before[sj] == thresholds[sj]) continue;
+    if (std::isnan(before[sj])) {  // new to the graph yet no source: nothing to compare it with
+      out[sj] = 1;
+      continue;
+    }
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it) {
+      const auto si = std::size_t(it.index());
+      if (si == sj || sources[si] || out[si]) continue;  // the diagonal stays; an end is a source already
+      const double w = it.value();
+      const bool was_kept = w >= before[sj] && w >= before[si];
+      const bool is_kept = w >= thresholds[sj] && w >= thresholds[si];
+      if (was_kept != is_kept) {
+        out[sj] = 1;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+/// Each node's neighbour threshold in the run `last` recorded, by id; NaN
+/// for a node it did not hold.
+std::vector<double> thresholdsBefore(const std::vector<int>& ids, const SplitCache::Store& last) {
+  std::vector<double> before(ids.size(), std::numeric_limits<double>::quiet_NaN());
+  std::size_t at = 0;
+  for (std::size_t n = 0; n < ids.size(); ++n) {
+    while (at < last.threshold_ids.size() && last.threshold_ids[at] < ids[n]) ++at;
+    if (at < last.threshold_ids.size() && last.threshold_ids[at] == ids[n]) before[n] = last.thresholds[at];
+  }
+  return before;
+}
+
+/// The mutual-neighbour count of these options on W; 0: W is used as it is.
+int neighbourCount(const WeightMatrix& W, const PartitionOptions& options) {
+  if (options.mutual_neighbours == 0) return 0;
+  return mutualNeighbourCount(W, options.mutual_neighbours, options.mutual_neighbours_share);
+}
+
+}  // namespace
+
+Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options) {
+  if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
+  checkOptions(options);
   checkWeights(W);
-  Partition partition = Partitioner(W, options).run();
-  if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, std::max(1, options.min_group_size), partition);
+  const int k = neighbourCount(W, options);
+  WeightMatrix kept;
+  if (k > 0) kept = mutualNeighbourGraph(W, neighbourThresholds(W, k));
+  const WeightMatrix& graph = k > 0 ? kept : W;
+  Partition partition = Partitioner(graph, options).run();
+  if (options.boundary_passes > 0) refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), partition);
   return partition;
 }
 
@@ -455,10 +525,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
 Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& options, const std::vector<int>& ids,
                              const std::vector<char>& changed, const std::vector<char>& sources, SplitCache& cache) {
   if (W.rows() != W.cols()) throw std::invalid_argument("recursivePartition: W must be square");
-  if (!(options.ncut_threshold >= 0.0))
-    throw std::invalid_argument("recursivePartition: the Ncut threshold must be >= 0");
-  if (options.boundary_passes < 0)
-    throw std::invalid_argument("recursivePartition: boundary_passes must be >= 0");
+  checkOptions(options);
   if (!options.eigen.elimination_rank.empty())
     throw std::invalid_argument("recursivePartition: a split cache needs each node to order itself (no elimination_rank)");
   if (Eigen::Index(ids.size()) != W.rows() || Eigen::Index(changed.size()) != W.rows() ||
@@ -477,12 +544,31 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   }
   auto next = std::make_shared<SplitCache::Store>();
   next->weights_checked = true;
-  Reuse reuse{ids, sources, *cache.store_, *next, *cache.workspaces_};
+  const int k = neighbourCount(W, options);
+  WeightMatrix kept;
+  std::vector<char> moved_sources;
+  if (k > 0) {
+    // A row that did not change has the threshold it had, for the same k.
+    const SplitCache::Store& last = *cache.store_;
+    const std::vector<double> before = thresholdsBefore(ids, last);
+    std::vector<double> thresholds = before;
+    std::vector<char> rows = changed;
+    for (std::size_t n = 0; n < ids.size(); ++n)
+      if (last.neighbour_count != k || std::isnan(before[n])) rows[n] = 1;
+    updateNeighbourThresholds(W, k, rows, thresholds);
+    kept = mutualNeighbourGraph(W, thresholds);
+    moved_sources = keptEntrySources(W, sources, before, thresholds, k, last);
+    next->neighbour_count = k;
+    next->threshold_ids = ids;
+    next->thresholds = std::move(thresholds);
+  }
+  const WeightMatrix& graph = k > 0 ? kept : W;
+  Reuse reuse{ids, k > 0 ? moved_sources : sources, *cache.store_, *next, *cache.workspaces_};
   try {
-    Partition partition = Partitioner(W, options, &reuse).run();
+    Partition partition = Partitioner(graph, options, &reuse).run();
     cache.store_ = std::move(next);
-    // After the tree, from all of W: the same as the batch's, whatever was reused.
-    if (options.boundary_passes > 0) refineBoundaries(W, options.boundary_passes, std::max(1, options.min_group_size), partition);
+    // After the tree, from all of the graph: the same as the batch's, whatever was reused.
+    if (options.boundary_passes > 0) refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), partition);
     return partition;
   } catch (...) {
     cache.clear();  // partly moved on: the next run computes every node

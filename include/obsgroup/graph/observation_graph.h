@@ -61,4 +61,26 @@ void checkWeightMatrixSize(const std::string& who, const WeightMatrix& W, Eigen:
 /// ascending, components ordered by their smallest node.
 std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W);
 
+/// How many neighbours each observation keeps in the mutual-neighbour graph:
+/// max(at_least, share x the median number of neighbours of a node, diagonal
+/// not counted, rounded). A map sampled twice as densely has twice the
+/// neighbours, so `share` keeps the graph the same; `at_least` keeps sparse
+/// maps as they are.
+int mutualNeighbourCount(const WeightMatrix& W, int at_least, double share);
+
+/// Per node, the weight of its k-th strongest edge (the diagonal not
+/// counted), or 0 when it has k edges or fewer: the edges at or above it are
+/// the node's k nearest neighbours (ties all kept).
+std::vector<double> neighbourThresholds(const WeightMatrix& W, int k);
+/// The same for the nodes flagged in `rows` only (one flag per node), the
+/// others' entries of `thresholds` (one per node) left as they are.
+void updateNeighbourThresholds(const WeightMatrix& W, int k, const std::vector<char>& rows,
+                               std::vector<double>& thresholds);
+
+/// The mutual k-nearest-neighbour graph of W (von Luxburg, "A tutorial on
+/// spectral clustering", 2007, sec. 2.2): W_ij is kept when it is at or
+/// above the thresholds of both i and j (neighbourThresholds), otherwise
+/// dropped; the diagonal is kept. Symmetric when W is.
+WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds);
+
 }  // namespace obsgroup

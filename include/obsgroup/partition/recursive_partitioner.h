@@ -32,6 +32,16 @@ struct PartitionOptions {
   /// doorway sees both sides, and the bisection puts it on either; its mean
   /// overlap is higher with the members of its own room (docs/method.md).
   int boundary_passes = 0;
+  /// The split tree and the boundary refinement work on W's mutual-neighbour
+  /// graph: W_ij kept when j is among the k observations i overlaps most and
+  /// i among j's (mutualNeighbourGraph), k = max(mutual_neighbours,
+  /// mutual_neighbours_share x the median number of neighbours). 0: W as
+  /// it is, the paper's (the share is then not used). In a building whose corridor the robot drove
+  /// many times, a small room's scans each overlap a hundred corridor scans
+  /// a little, which adds up to more than the room's own few; none of those
+  /// corridor scans counts the room's among its k nearest (docs/method.md).
+  int mutual_neighbours = 0;
+  double mutual_neighbours_share = 0.0;
   /// Keep each node's eigenvector in the split tree (for plots and analysis).
   bool keep_eigenvectors = true;
   /// Threads over the nodes of one level of the split tree (0: OpenMP's
