@@ -79,7 +79,8 @@ struct SplitCache::Store {
   /// whose unchanged rows an earlier such run had checked.
   bool weights_checked = false;
   /// The mutual-neighbour count of the run and each node's threshold, by
-  /// id (ascending): a node whose threshold moves is a source of the next.
+  /// id (ascending): the next run finds from them which kept entries moved
+  /// (keptEntrySources).
   int neighbour_count = 0;
   std::vector<int> threshold_ids;
   std::vector<double> thresholds;

@@ -64,8 +64,8 @@ std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W);
 /// How many neighbours each observation keeps in the mutual-neighbour graph:
 /// max(at_least, share x the median number of neighbours of a node, diagonal
 /// not counted, rounded). A map sampled twice as densely has twice the
-/// neighbours, so `share` keeps the graph the same; `at_least` keeps sparse
-/// maps as they are.
+/// neighbours, and through `share` twice the k; `at_least` leaves the
+/// observations of sparse maps, which have fewer neighbours, all of theirs.
 int mutualNeighbourCount(const WeightMatrix& W, int at_least, double share);
 
 /// Per node, the weight of its k-th strongest edge (the diagonal not
