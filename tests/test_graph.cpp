@@ -73,6 +73,9 @@ TEST(ObservationGraph, MutualNeighboursKeepAnEdgeOnlyWhenBothEndsRankItAmongThei
   const WeightMatrix T = buildWeightMatrix(4, {{0, 1, 0.5}, {0, 2, 0.5}, {0, 3, 0.5}});
   EXPECT_EQ(mutualNeighbourGraph(T, neighbourThresholds(T, 1)).nonZeros(), 6);
   EXPECT_THROW(mutualNeighbourGraph(W, {0.0}), std::invalid_argument);
+  // No nodes: an empty graph.
+  const WeightMatrix none(0, 0);
+  EXPECT_EQ(mutualNeighbourGraph(none, neighbourThresholds(none, 3)).rows(), 0);
 }
 
 TEST(ObservationGraph, MutualNeighbourCountGrowsWithTheMedianNumberOfNeighbours) {

@@ -174,19 +174,11 @@ void updateNeighbourThresholds(const WeightMatrix& W, int k, const std::vector<c
 WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds) {
   if (Eigen::Index(thresholds.size()) != W.outerSize())
     throw std::invalid_argument("mutualNeighbourGraph: one threshold per node expected");
-  WeightMatrix kept(W.rows(), W.cols());
-  std::vector<int> sizes(std::size_t(W.outerSize()), 0);
-  const auto keep = [&thresholds](Eigen::Index i, Eigen::Index j, double w) {
+  WeightMatrix kept = W;
+  kept.prune([&thresholds](const Eigen::Index& i, const Eigen::Index& j, const double& w) {
     return i == j || (w >= thresholds[std::size_t(i)] && w >= thresholds[std::size_t(j)]);
-  };
-  for (Eigen::Index j = 0; j < W.outerSize(); ++j)
-    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
-      if (keep(it.index(), j, it.value())) ++sizes[std::size_t(j)];
-  kept.reserve(sizes);
-  for (Eigen::Index j = 0; j < W.outerSize(); ++j)
-    for (WeightMatrix::InnerIterator it(W, j); it; ++it)
-      if (keep(it.index(), j, it.value())) kept.insert(it.index(), j) = it.value();
-  kept.makeCompressed();
+  });
+  kept.data().squeeze();  // the dropped entries' storage back
   return kept;
 }
 
