@@ -225,6 +225,18 @@ class DeflatedNormalizedAdjacency {
 constexpr double kDenseGraphShare = 0.125;
 constexpr double kDenseGraphDegree = 48.0;
 
+/// Lanczos vectors of each solve (Spectra's ncv). Through the Laplacian's
+/// inverse the Fiedler pair has converged after about a dozen steps, and
+/// Spectra tests convergence only once its basis is full: a basis of 20 took
+/// 21 applications of the operator (each two triangular solves) in every
+/// solve of the 1,001-scan stream, a basis of 12 takes 14.9 on average (the
+/// extra ones in a restart), the same groups on every dataset measured
+/// (docs/performance.md). The product form converges more slowly and keeps a
+/// wider basis; the wide one is the retry when a solve did not converge.
+constexpr int kInverseLanczosVectors = 12;
+constexpr int kProductLanczosVectors = 20;
+constexpr int kWideLanczosVectors = 80;
+
 /// The Rayleigh quotient z'Lz of eq. (8) (the eigenvalue, for an
 /// eigenvector) and the residual ||L z - (z'Lz) z|| of a unit z: one product.
 struct EigenCheck {
@@ -326,14 +338,15 @@ FiedlerResult fiedlerVector(const WeightMatrix& W, const FiedlerOptions& options
   const bool want_sparse = options.solver == EigenSolver::Sparse ||
                            (options.solver == EigenSolver::Auto && n > options.dense_max_size);
   if (want_sparse && n > 2) {
-    const int ncv = static_cast<int>(std::min<Eigen::Index>(n, 20));
+    const auto basis = [n](int vectors) { return static_cast<int>(std::min<Eigen::Index>(n, vectors)); };
     const double degree = double(W.nonZeros()) / double(n);
     const bool dense_graph = degree >= kDenseGraphDegree && degree >= kDenseGraphShare * double(n);
-    const int wide_ncv = static_cast<int>(std::min<Eigen::Index>(n, 80));
-    result.sparse =
-        (dense_graph && solveSparse<DeflatedNormalizedAdjacency>(L, z0, options, buffers, ncv, z, checked)) ||
-        solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, ncv, z, checked) ||
-        solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, wide_ncv, z, checked);
+    result.sparse = (dense_graph && solveSparse<DeflatedNormalizedAdjacency>(L, z0, options, buffers,
+                                                                             basis(kProductLanczosVectors), z, checked)) ||
+                    solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, basis(kInverseLanczosVectors), z,
+                                                          checked) ||
+                    solveSparse<DeflatedLaplacianInverse>(L, z0, options, buffers, basis(kWideLanczosVectors), z,
+                                                          checked);
     result.fell_back = !result.sparse;
   }
   if (!result.sparse) {
