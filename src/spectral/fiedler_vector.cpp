@@ -19,19 +19,38 @@ namespace {
 /// D^-1/2 (D - W) D^-1/2 so that a non-zero diagonal of W is honoured; into
 /// L's storage.
 void normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_d, WeightMatrix& L) {
-  // D^-1/2 (D - W) D^-1/2 in one pass over W's columns, the diagonal entry
-  // inserted in row order. The arithmetic is that of the matrix expression,
-  // (s_i * ([i == j] d_i - w_ij)) * s_j, so the results are the same bits.
+  // D^-1/2 (D - W) D^-1/2 in one pass over W's columns, each written straight
+  // into L's compressed arrays with its diagonal entry in row order (W's
+  // pattern plus the diagonal: the size is known up front). The arithmetic is
+  // that of the matrix expression, (s_i * ([i == j] d_i - w_ij)) * s_j, so the
+  // results are the same bits. At the sizes of an online update's nodes the
+  // element-wise insertion this replaces was a twentieth of the stream.
   const Eigen::Index n = W.outerSize();
   const Eigen::VectorXd diagonal = inv_sqrt_d.cwiseInverse().cwiseAbs2();
-  L.resize(n, n);
-  L.reserve(W.nonZeros() + n);
+  Eigen::Index entries = 0;
   for (Eigen::Index j = 0; j < n; ++j) {
-    L.startVec(j);
+    bool has_diagonal = false;
+    for (WeightMatrix::InnerIterator it(W, j); it; ++it) {
+      ++entries;
+      has_diagonal = has_diagonal || it.row() == j;
+    }
+    if (!has_diagonal) ++entries;
+  }
+  L.resize(n, n);
+  L.resizeNonZeros(entries);
+  int* outer = L.outerIndexPtr();
+  int* inner = L.innerIndexPtr();
+  double* value = L.valuePtr();
+  Eigen::Index k = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    outer[j] = static_cast<int>(k);
+    const double s_j = inv_sqrt_d[j];
     bool diagonal_done = false;
     const auto put = [&](Eigen::Index i, double minus_w) {
       const double x = i == j ? minus_w + diagonal[j] : minus_w;
-      L.insertBack(i, j) = (inv_sqrt_d[i] * x) * inv_sqrt_d[j];
+      inner[k] = static_cast<int>(i);
+      value[k] = (inv_sqrt_d[i] * x) * s_j;
+      ++k;
     };
     for (WeightMatrix::InnerIterator it(W, j); it; ++it) {
       if (!diagonal_done && it.row() > j) {
@@ -43,7 +62,7 @@ void normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_
     }
     if (!diagonal_done) put(j, 0.0);
   }
-  L.finalize();
+  outer[n] = static_cast<int>(k);
 }
 
 using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
