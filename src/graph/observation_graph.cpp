@@ -75,19 +75,31 @@ WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& memb
   if (m > 0) checkMembers("inducedSubgraph", members, W.rows());
   for (int k = 0; k < m; ++k) local_of[members[k]] = k;
   // Members ascend, so local indices ascend with W's row indices: each column
-  // is filled in order, straight into compressed storage.
+  // is written in order straight into the compressed arrays, sized for every
+  // entry of the members' columns and cut to those kept (an entry-by-entry
+  // insertion cost a twentieth of an online update's partition).
   WeightMatrix sub(m, m);
   std::size_t entries = 0;
   for (int i : members)
     entries += static_cast<std::size_t>(W.isCompressed() ? W.outerIndexPtr()[i + 1] - W.outerIndexPtr()[i]
                                                          : W.innerNonZeroPtr()[i]);
-  sub.reserve(static_cast<Eigen::Index>(entries));
+  sub.resizeNonZeros(static_cast<Eigen::Index>(entries));
+  int* outer = sub.outerIndexPtr();
+  int* inner = sub.innerIndexPtr();
+  double* value = sub.valuePtr();
+  int k = 0;
   for (int local_col = 0; local_col < m; ++local_col) {
-    sub.startVec(local_col);
-    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it)
-      if (local_of[it.row()] >= 0) sub.insertBack(local_of[it.row()], local_col) = it.value();
+    outer[local_col] = k;
+    for (WeightMatrix::InnerIterator it(W, members[local_col]); it; ++it) {
+      const int local_row = local_of[it.row()];
+      if (local_row < 0) continue;
+      inner[k] = local_row;
+      value[k] = it.value();
+      ++k;
+    }
   }
-  sub.finalize();
+  outer[m] = k;
+  sub.resizeNonZeros(k);
   for (int i : members) local_of[i] = -1;
   return sub;
 }

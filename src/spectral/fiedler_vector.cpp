@@ -68,7 +68,7 @@ void normalizedLaplacian(const WeightMatrix& W, const Eigen::VectorXd& inv_sqrt_
 using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
 
 /// A symmetric sparse matrix without its last row and column, copied
-/// straight into B's storage, reserved at its exact size (a block assignment
+/// straight into B's compressed arrays, sized exactly (a block assignment
 /// grows its storage as it goes, a copy and fresh pages at each step).
 void withoutLastNode(const WeightMatrix& A, WeightMatrix& B) {
   const Eigen::Index m = A.rows() - 1;
@@ -76,12 +76,19 @@ void withoutLastNode(const WeightMatrix& A, WeightMatrix& B) {
   for (Eigen::Index j = 0; j < m; ++j)
     for (WeightMatrix::InnerIterator it(A, j); it && it.row() < m; ++it) ++entries;
   B.resize(m, m);
-  B.reserve(entries);
+  B.resizeNonZeros(entries);
+  int* outer = B.outerIndexPtr();
+  int* inner = B.innerIndexPtr();
+  double* value = B.valuePtr();
+  Eigen::Index k = 0;
   for (Eigen::Index j = 0; j < m; ++j) {
-    B.startVec(j);
-    for (WeightMatrix::InnerIterator it(A, j); it && it.row() < m; ++it) B.insertBack(it.row(), j) = it.value();
+    outer[j] = static_cast<int>(k);
+    for (WeightMatrix::InnerIterator it(A, j); it && it.row() < m; ++it, ++k) {
+      inner[k] = static_cast<int>(it.row());
+      value[k] = it.value();
+    }
   }
-  B.finalize();
+  outer[m] = static_cast<int>(k);
 }
 
 /// AMD's order of a compressed matrix whose pattern is symmetric, the same
