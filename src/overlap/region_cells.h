@@ -519,13 +519,22 @@ class DoorCrossing {
  public:
   /// For a ray of unit direction (cos, sin of its angle).
   DoorCrossing(const RegionParameters& params, double cell_size, const std::array<double, 2>& direction)
-      : width_(params.door_width / cell_size), depth_(params.door_depth / cell_size) {
+      : depth_(params.door_depth / cell_size) {
+    const double width = params.door_width / cell_size;  // in cells
     const double dx = direction[0], dy = direction[1];
     for (int k = 0; k < OpeningWidths::kAxes; ++k) {
       const auto a = OpeningWidths::axis(k);
       const double length = std::hypot(double(a[0]), double(a[1]));
       // Across the ray: the axes at least 45 degrees from its direction.
-      if (std::abs(a[0] * dx + a[1] * dy) / length <= std::sqrt(0.5) + 1e-9) across_[count_++] = {k, length};
+      if (std::abs(a[0] * dx + a[1] * dy) / length <= std::sqrt(0.5) + 1e-9) {
+        // A run of r cells is narrower than a door when r * length < width:
+        // true below the first r for which it is false (at most width + 1,
+        // under 252 cells), found with the same products, so that the walk
+        // compares integers and decides exactly as the products would.
+        std::uint32_t narrow_below = 0;
+        while (double(narrow_below) * length < width) ++narrow_below;
+        across_[count_++] = {k, narrow_below};
+      }
     }
   }
   /// The ray starts in a doorway and leaves it on the far side from the
@@ -535,7 +544,7 @@ class DoorCrossing {
   bool narrowAt(const Cell<2>& c, const OpeningWidths& widths) const {
     for (int j = 0; j < count_; ++j) {
       const std::uint32_t run = widths.run(c, across_[j].axis);
-      if (run != OpeningWidths::kOpen && run * across_[j].length < width_) return true;
+      if (run != OpeningWidths::kOpen && run < across_[j].narrow_below) return true;
     }
     return false;
   }
@@ -557,9 +566,9 @@ class DoorCrossing {
   enum class State { kNarrow, kWide, kInDoor };
   struct Across {
     int axis;
-    double length;
+    std::uint32_t narrow_below;  ///< runs of fewer cells are narrower than a door along this axis
   };
-  double width_, depth_;
+  double depth_;
   std::array<Across, OpeningWidths::kAxes> across_{};
   int count_ = 0;
   State state_ = State::kNarrow;
