@@ -255,7 +255,7 @@ constexpr double kDenseGraphDegree = 48.0;
 /// inverse the Fiedler pair has converged after about a dozen steps, and
 /// Spectra tests convergence only once its basis is full: a basis of 20 took
 /// 21 applications of the operator (each two triangular solves) in every
-/// solve of the 1,001-scan stream, a basis of 12 takes 14.9 on average (the
+/// solve of the 1,001-scan stream, a basis of 12 takes 15.0 on average (the
 /// extra ones in a restart), the same groups on every dataset measured
 /// (docs/performance.md). The product form converges more slowly and keeps a
 /// wider basis; the wide one is the retry when a solve did not converge.
