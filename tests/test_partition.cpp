@@ -3,6 +3,7 @@
 #include "test_support.h"
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/common/parallel_for.h>
 #include <obsgroup/partition/keyframes.h>
 
 #include <gtest/gtest.h>
@@ -355,6 +356,60 @@ TEST(RecursivePartition, TheSplitCacheFollowsTheMutualNeighboursOfAGrowingGraph)
       ASSERT_EQ(0, std::memcmp(&cached.splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << n << " nodes, node " << k;
   }
   EXPECT_GT(cache.reusedNodes(), 0u);
+}
+
+TEST(RecursivePartition, NodesSolvedAheadOfTheirLevelGiveTheDecisionsOfOneThread) {
+  // Rooms of six scans along a corridor, one scan at a time, as a robot
+  // drives: every insert changes the nodes on the path from the root to its
+  // group, and two threads solve the path's lower nodes ahead, from the
+  // previous tree. Each node's decision must be the one a single thread (which
+  // solves nothing ahead) and a run from scratch give, to the bit, including
+  // where the guess was wrong (a room that starts after the previous run).
+  std::vector<WeightedPair> pairs;
+  const auto roomOf = [](int i) { return i / 6; };
+  PartitionOptions options = GroupingParameters{}.partitionOptions();
+  options.min_group_size = 2;
+  SplitCache one_thread, two_threads;
+  std::size_t ahead_nodes = 0, ahead_used = 0, groups = 0;
+  for (int n = 2; n <= 96; ++n) {
+    const int added = n - 1;
+    for (int j = std::max(0, added - 12); j < added; ++j) {
+      const bool same_room = roomOf(j) == roomOf(added);
+      const double w = same_room ? 0.8 + 0.01 * ((added * 5 + j) % 7) : 0.05 / (1 + roomOf(added) - roomOf(j));
+      pairs.push_back({j, added, w});
+    }
+    const WeightMatrix W = buildWeightMatrix(n, pairs);
+    std::vector<int> ids(n);
+    for (int i = 0; i < n; ++i) ids[i] = i;
+    std::vector<char> changed(n, 0), sources(n, 0);
+    for (int j = std::max(0, added - 12); j <= added; ++j) changed[j] = 1;
+    sources[added] = 1;
+    const Partition fresh = recursivePartition(W, options);
+    options.threads = 1;
+    const Partition single = recursivePartition(W, options, ids, changed, sources, one_thread);
+    options.threads = 2;
+    const Partition ahead = recursivePartition(W, options, ids, changed, sources, two_threads);
+    for (const Partition* p : {&single, &ahead}) {
+      ASSERT_EQ(p->groups, fresh.groups) << n << " nodes";
+      ASSERT_EQ(p->splits.size(), fresh.splits.size()) << n << " nodes";
+      for (std::size_t k = 0; k < fresh.splits.size(); ++k) {
+        ASSERT_EQ(p->splits[k].members, fresh.splits[k].members) << n << " nodes, node " << k;
+        ASSERT_EQ(p->splits[k].depth, fresh.splits[k].depth) << n << " nodes, node " << k;
+        ASSERT_EQ(0, std::memcmp(&p->splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << n << " nodes, node " << k;
+        ASSERT_EQ(0, std::memcmp(&p->splits[k].eigenvalue, &fresh.splits[k].eigenvalue, sizeof(double)))
+            << n << " nodes, node " << k;
+      }
+    }
+    EXPECT_EQ(one_thread.aheadNodes(), 0u);
+    ahead_nodes += two_threads.aheadNodes();
+    ahead_used += two_threads.aheadNodesUsed();
+    groups = fresh.groups.size();
+  }
+  EXPECT_EQ(groups, 16u);
+  if (threadCount(2) > 1) {  // built with OpenMP: two threads solve ahead
+    EXPECT_GT(ahead_used, 0u);
+    EXPECT_LT(ahead_used, ahead_nodes);  // some guesses were wrong, and nothing showed it
+  }
 }
 
 TEST(Keyframes, AFrameIsAKeyframeWhenItMovedOrTurnedEnoughSinceTheLast) {

@@ -453,6 +453,7 @@ class PyOnlineGrouping {
     d["observations_recomputed"] = update.observations_recomputed;
     d["split_nodes_reused"] = update.split_nodes_reused;
     d["split_nodes_computed"] = update.split_nodes_computed;
+    d["split_nodes_ahead"] = update.split_nodes_ahead;
     return d;
   }
   std::map<int, std::vector<int>> groups() const { return online_.getGroups(); }

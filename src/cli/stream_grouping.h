@@ -51,7 +51,8 @@ inline std::size_t edgeCount(const WeightMatrix& W) {
 
 /// What the updates of a stream did, summed.
 struct StreamTotals {
-  std::size_t updates = 0, observations_recomputed = 0, split_nodes_reused = 0, split_nodes_computed = 0;
+  std::size_t updates = 0, observations_recomputed = 0, split_nodes_reused = 0, split_nodes_computed = 0,
+              split_nodes_ahead = 0;
   double online_s = 0.0;  ///< inserts and updates, waits excluded
 };
 
@@ -91,6 +92,7 @@ void updateAndPrint(OnlineGrouping<PointT>& online, int first_id, int last_id, b
   totals.observations_recomputed += update.observations_recomputed;
   totals.split_nodes_reused += update.split_nodes_reused;
   totals.split_nodes_computed += update.split_nodes_computed;
+  totals.split_nodes_ahead += update.split_nodes_ahead;
   if (quiet) return;
   if (verbose) {
     for (const GroupChange& change : update.changes)
@@ -173,7 +175,8 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
                     {"updates", totals.updates},
                     {"observations_recomputed", totals.observations_recomputed},
                     {"split_nodes_reused", totals.split_nodes_reused},
-                    {"split_nodes_computed", totals.split_nodes_computed}};
+                    {"split_nodes_computed", totals.split_nodes_computed},
+                    {"split_nodes_ahead", totals.split_nodes_ahead}};
   const double world_s = std::chrono::duration<double>(ReplayClock::Clock::now() - start).count();
   out.timing_s = {{"stream", totals.online_s}, {"world_points", world_s}};
   if (args.stream->realtime) out.timing_s["realtime_wait"] = clock.waitedSeconds();

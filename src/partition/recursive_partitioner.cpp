@@ -75,6 +75,9 @@ struct SplitCache::Store {
   };
   std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
   std::size_t reused = 0, computed = 0;
+  /// Nodes solved ahead of their level (Partitioner::guessPath): all, and
+  /// those whose decision the run then took.
+  std::size_t ahead = 0, ahead_used = 0;
   /// Filled by a run that checked every row of its W (checkWeights), or
   /// whose unchanged rows an earlier such run had checked.
   bool weights_checked = false;
@@ -84,6 +87,9 @@ struct SplitCache::Store {
   int neighbour_count = 0;
   std::vector<int> threshold_ids;
   std::vector<double> thresholds;
+  /// The ids of the run's nodes (ascending): which members of a node are
+  /// new since (Partitioner::guessPath).
+  std::vector<int> ids;
 
   Entry* find(const std::vector<int>& member_ids, int depth) {
     const auto it = entries.find(nodeKey(member_ids, depth));
@@ -103,6 +109,8 @@ SplitCache::SplitCache()
 void SplitCache::clear() { *store_ = Store{}; }
 std::size_t SplitCache::reusedNodes() const { return store_->reused; }
 std::size_t SplitCache::computedNodes() const { return store_->computed; }
+std::size_t SplitCache::aheadNodes() const { return store_->ahead; }
+std::size_t SplitCache::aheadNodesUsed() const { return store_->ahead_used; }
 
 namespace {
 
@@ -136,6 +144,7 @@ class Partitioner {
 
   Partition run() {
     const int n = static_cast<int>(W_.rows());
+    speculate_ = reuse_ != nullptr && threadCount(options_.threads) > 1 && !reuse_->previous.ids.empty();
     std::vector<int> frontier;
     if (n > 0) {
       SplitNode root;
@@ -156,19 +165,36 @@ class Partitioner {
       // which then runs on this thread without an OpenMP team.
       std::vector<std::size_t> to_solve;
       for (std::size_t k = 0; k < frontier.size(); ++k)
-        if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k])) to_solve.push_back(k);
+        if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k]) &&
+            !takeGuessed(out_.splits[frontier[k]], decisions[k]))
+          to_solve.push_back(k);
+      // Online, the nodes to solve form a path, one node a level, each
+      // known only once its parent is decided. The previous run's tree
+      // says what the path most likely is: its nodes are solved now, beside
+      // this level's, on the other threads (see guessPath).
+      std::vector<SplitNode> guesses;
+      if (speculate_)
+        for (std::size_t k : to_solve) guessPath(out_.splits[frontier[k]], guesses);
+      std::vector<Decision> guessed(guesses.size());
       // Each thread has its own scratch for inducedSubgraph and its own
       // workspace, taken in turn (not by OpenMP's thread number: a level run
       // on the calling thread may be inside a caller's own team); the first
       // failing node's exception is rethrown unchanged (an input error stays one).
       std::atomic<std::size_t> next_workspace{0};
       parallelForWithScratch(
-          to_solve.size(), options_.threads, 1,
+          to_solve.size() + guesses.size(), options_.threads, 1,
           [&] { return NodeScratch{std::vector<int>(n, -1), &workspaces_.at(next_workspace++)}; },
           [&](std::size_t j, NodeScratch& scratch) {
+            if (j >= to_solve.size()) {
+              guessed[j - to_solve.size()] = decide(guesses[j - to_solve.size()], scratch);
+              return;
+            }
             const std::size_t k = to_solve[j];
             decisions[k] = decide(out_.splits[frontier[k]], scratch);
           });
+      for (std::size_t g = 0; g < guesses.size(); ++g)
+        addGuessed(idsOf(guesses[g].members), guesses[g].depth, std::move(guessed[g]));
+      if (reuse_) reuse_->next.ahead += guesses.size();
       std::vector<int> next;
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];
@@ -216,6 +242,122 @@ class Partitioner {
         member = int(std::lower_bound(reuse_->ids.begin(), reuse_->ids.end(), member) - reuse_->ids.begin());
     d.from_cache = true;
     return true;
+  }
+
+  /// The decision of a node solved ahead (guessPath) with exactly these
+  /// members: a node's decision depends on its block of W alone, so it is
+  /// the one this node would get. Below max_depth a node's depth only
+  /// numbers its children, so one solved at another depth serves too, its
+  /// children's depth moved by the difference.
+  bool takeGuessed(const SplitNode& current, Decision& d) {
+    if (!speculate_ || guessed_.empty()) return false;
+    Guessed* guess = findGuessed(idsOf(current.members), current.depth);
+    if (!guess) return false;
+    d = std::move(guess->decision);
+    d.child_depth += current.depth - guess->depth;
+    guess->member_ids.clear();  // taken: no node is visited twice in a run
+    ++reuse_->next.ahead_used;
+    return true;
+  }
+
+  struct Guessed {
+    std::vector<int> member_ids;
+    int depth;
+    Decision decision;
+  };
+  void addGuessed(std::vector<int> member_ids, int depth, Decision decision) {
+    const std::uint64_t key = nodeKey(member_ids, 0);
+    guessed_[key].push_back({std::move(member_ids), depth, std::move(decision)});
+  }
+  /// A node solved ahead with these members whose decision holds at `depth`.
+  Guessed* findGuessed(const std::vector<int>& member_ids, int depth) {
+    const auto it = guessed_.find(nodeKey(member_ids, 0));
+    if (it == guessed_.end()) return nullptr;
+    const int max_depth = options_.max_depth;
+    for (Guessed& g : it->second)
+      if (g.member_ids == member_ids && (g.depth == depth || (g.depth < max_depth && depth < max_depth))) return &g;
+    return nullptr;
+  }
+
+  /// Guesses the nodes below `node` (about to be solved) that will need
+  /// solving: the previous run's children of the node it was then (its
+  /// members without the new ones, at the same depth), each new member
+  /// joining the child it is most strongly linked to; then the same below
+  /// each guessed child holding a source, down to the leaves. Appends to
+  /// `guesses` those not solved or guessed already.
+  void guessPath(const SplitNode& node, std::vector<SplitNode>& guesses) {
+    const std::vector<int>& previous_ids = reuse_->previous.ids;
+    const auto was_there = [&previous_ids](int id) {
+      return std::binary_search(previous_ids.begin(), previous_ids.end(), id);
+    };
+    struct Pending {
+      std::vector<int> old_members, fresh;  // current indices: in the previous run, and new since
+      int depth;
+    };
+    std::vector<Pending> pending(1);
+    for (int i : node.members) (was_there(reuse_->ids[i]) ? pending[0].old_members : pending[0].fresh).push_back(i);
+    pending[0].depth = node.depth;
+    if (child_of_.size() != std::size_t(W_.rows())) child_of_.assign(std::size_t(W_.rows()), -1);
+    while (!pending.empty()) {
+      Pending at = std::move(pending.back());
+      pending.pop_back();
+      const auto* entry = reuse_->previous.find(idsOf(at.old_members), at.depth);
+      if (!entry || entry->decision.children.size() < 2) continue;
+      const auto& children = entry->decision.children;  // by id
+      std::vector<std::vector<int>> old_children(children.size()), predicted(children.size());
+      for (std::size_t c = 0; c < children.size(); ++c)
+        for (int id : children[c]) {
+          const auto found = std::lower_bound(reuse_->ids.begin(), reuse_->ids.end(), id);
+          if (found == reuse_->ids.end() || *found != id) continue;  // no longer in the graph
+          const int i = int(found - reuse_->ids.begin());
+          old_children[c].push_back(i);
+          child_of_[std::size_t(i)] = int(c);
+        }
+      // New members join the child they weigh most to; those linked only
+      // to other new ones in a second pass.
+      std::vector<int> unplaced = at.fresh;
+      std::vector<double> weight(children.size());
+      for (int pass = 0; pass < 2 && !unplaced.empty(); ++pass) {
+        std::vector<int> left;
+        for (int i : unplaced) {
+          std::fill(weight.begin(), weight.end(), 0.0);
+          for (WeightMatrix::InnerIterator it(W_, i); it; ++it) {
+            const int c = child_of_[std::size_t(it.row())];
+            if (it.row() != i && c >= 0) weight[std::size_t(c)] += it.value();
+          }
+          const auto best = std::max_element(weight.begin(), weight.end());
+          if (*best > 0.0) {
+            predicted[std::size_t(best - weight.begin())].push_back(i);
+            child_of_[std::size_t(i)] = int(best - weight.begin());
+          } else {
+            left.push_back(i);
+          }
+        }
+        unplaced = std::move(left);
+      }
+      for (const auto& child : old_children)
+        for (int i : child) child_of_[std::size_t(i)] = -1;
+      for (const auto& child : predicted)
+        for (int i : child) child_of_[std::size_t(i)] = -1;
+      if (!unplaced.empty()) continue;  // the guess would miss members: none of its children is right
+      // Each child holding a source will be solved (the others are cached):
+      // guessed, and followed down.
+      const int child_depth = entry->decision.child_depth;
+      for (std::size_t c = 0; c < children.size(); ++c) {
+        SplitNode guess;
+        guess.members = old_children[c];
+        guess.members.insert(guess.members.end(), predicted[c].begin(), predicted[c].end());
+        std::sort(guess.members.begin(), guess.members.end());
+        guess.depth = child_depth;
+        if (std::none_of(guess.members.begin(), guess.members.end(), [this](int i) { return reuse_->sources[i] != 0; }))
+          continue;
+        pending.push_back({std::move(old_children[c]), std::move(predicted[c]), child_depth});
+        if (findGuessed(idsOf(guess.members), child_depth)) continue;
+        bool listed = false;
+        for (const SplitNode& g : guesses) listed = listed || (g.depth == child_depth && g.members == guess.members);
+        if (!listed) guesses.push_back(std::move(guess));
+      }
+    }
   }
 
   /// Keeps this node's decision, by ids, for the next run: a copied one is
@@ -344,6 +486,9 @@ class Partitioner {
   const PartitionOptions& options_;
   const std::vector<int> rank_;  // see eliminationRanks
   Reuse* reuse_;
+  bool speculate_ = false;            // solve the likely path ahead (guessPath)
+  std::unordered_map<std::uint64_t, std::vector<Guessed>> guessed_;  // decisions solved ahead, by ids
+  std::vector<int> child_of_;         // guessPath's scratch: a node's child, or -1
   std::vector<FiedlerWorkspace> own_workspaces_;  // this run's, unless the cache keeps them
   std::vector<FiedlerWorkspace>& workspaces_;
   Partition out_;
@@ -545,6 +690,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   }
   auto next = std::make_shared<SplitCache::Store>();
   next->weights_checked = true;
+  next->ids = ids;
   const int k = neighbourCount(W, options);
   WeightMatrix kept;
   std::vector<char> moved_sources;

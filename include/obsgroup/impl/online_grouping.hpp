@@ -214,6 +214,7 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std
   partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, sources, cache_);
   out.split_nodes_reused = cache_.reusedNodes();
   out.split_nodes_computed = cache_.computedNodes();
+  out.split_nodes_ahead = cache_.aheadNodes();
   std::fill(pending_.begin(), pending_.end(), 0);
   std::fill(pending_sources_.begin(), pending_sources_.end(), 0);
   changes_since_exact_ = 0;

@@ -49,6 +49,9 @@ struct GroupUpdate {
   std::size_t observations_recomputed = 0;  ///< Observations whose overlaps were recomputed.
   std::size_t split_nodes_reused = 0;       ///< Nodes of the split tree copied from the last update.
   std::size_t split_nodes_computed = 0;     ///< Nodes solved anew by an exact update (0 for a local one).
+  /// Nodes solved ahead of their level on another thread (SplitCache::aheadNodes), whether the update
+  /// then met them or not: those it met are among split_nodes_computed, the others were guessed wrong.
+  std::size_t split_nodes_ahead = 0;
 };
 
 /// Group ids that survive re-partitions: a group whose members did not

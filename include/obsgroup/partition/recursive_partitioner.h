@@ -125,6 +125,14 @@ class SplitCache {
   /// Nodes of the last run whose decision was copied / computed.
   std::size_t reusedNodes() const;
   std::size_t computedNodes() const;
+  /// Of the computed nodes, those solved ahead of their level, beside the
+  /// level's own on another thread, from a guess of the path the run would
+  /// take (its members in the previous run's tree); and of those, the ones
+  /// the run then met. A node's decision depends on its block of W alone, so
+  /// one solved ahead is the decision it gets in turn: the result is the same
+  /// for any thread count. One thread solves nothing ahead.
+  std::size_t aheadNodes() const;
+  std::size_t aheadNodesUsed() const;
 
   struct Store;  ///< opaque
 
