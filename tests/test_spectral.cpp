@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <random>
@@ -179,27 +180,84 @@ TEST(Fiedler, AnyEliminationOrderGivesTheSameVector) {
   EXPECT_THROW(fiedlerVector(W, wrong), std::invalid_argument);
 }
 
-TEST(Fiedler, ItsOwnOrderingIsEigensAMDOrdering) {
-  // fiedlerVector orders the grounded Laplacian (all nodes but the last) with
-  // AMD from its pattern alone, without Eigen's AMDOrdering's copies. Handing
-  // it Eigen's AMDOrdering of the same pattern as ranks must give the very
-  // same factor, hence the same bits.
+/// The grounded Laplacian's pattern (all nodes but the last), and the
+/// elimination ranks that hand fiedlerVector an order of it.
+WeightMatrix groundedPattern(const WeightMatrix& W) {
+  const int n = int(W.rows());
+  WeightMatrix identity(n, n);
+  identity.setIdentity();
+  return WeightMatrix(W + identity).topLeftCorner(n - 1, n - 1);
+}
+std::vector<int> ranksOf(const int* eliminated, int n) {
+  std::vector<int> rank(std::size_t(n), n - 1);
+  for (int k = 0; k + 1 < n; ++k) rank[std::size_t(eliminated[k])] = k;
+  return rank;
+}
+/// Entries of the factor below the diagonal, over those of the matrix, in
+/// the order `eliminated`.
+double factorFill(const WeightMatrix& pattern, const std::vector<int>& eliminated) {
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order(Eigen::Index(eliminated.size()));
+  std::copy(eliminated.begin(), eliminated.end(), order.indices().data());
+  WeightMatrix spd = pattern;
+  for (int k = 0; k < spd.outerSize(); ++k)
+    for (WeightMatrix::InnerIterator it(spd, k); it; ++it) it.valueRef() = it.row() == it.col() ? 1e3 : -1.0;
+  WeightMatrix permuted;
+  permuted.selfadjointView<Eigen::Upper>() = spd.selfadjointView<Eigen::Lower>().twistedBy(order.inverse());
+  Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt(permuted);
+  return double(ldlt.matrixL().nestedExpression().nonZeros()) / double((pattern.nonZeros() - pattern.rows()) / 2);
+}
+
+TEST(Fiedler, ItsOwnOrderingIsMaximumCardinalitySearchWhereThatDoesNotFillIn) {
+  // A route's overlaps reach a few scans ahead: a chordal graph, whose factor
+  // in the search's order has no fill. fiedlerVector orders its grounded
+  // Laplacian so, from the pattern alone: handing it the same order as ranks
+  // gives the very same factor, hence the same bits.
   for (const WeightMatrix& W : {routeGraph(700, 8, 17), routeGraph(400, 20, 19)}) {
     const int n = int(W.rows());
-    WeightMatrix identity(n, n);
-    identity.setIdentity();
-    const WeightMatrix pattern = WeightMatrix(W + identity).topLeftCorner(n - 1, n - 1);  // L's pattern
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> amd;
-    Eigen::AMDOrdering<int>()(pattern, amd);
+    const WeightMatrix pattern = groundedPattern(W);
+    const std::vector<int> search = maximumCardinalityOrder(pattern);
+    ASSERT_EQ(int(search.size()), n - 1);
+    std::vector<int> sorted = search;
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k + 1 < n; ++k) ASSERT_EQ(sorted[std::size_t(k)], k);  // a permutation
+    EXPECT_EQ(factorFill(pattern, search), 1.0);
     FiedlerOptions options = withSolver(EigenSolver::Sparse);
-    options.elimination_rank.assign(std::size_t(n), n - 1);
-    for (int k = 0; k + 1 < n; ++k) options.elimination_rank[std::size_t(amd.indices()[k])] = k;
+    options.elimination_rank = ranksOf(search.data(), n);
     const FiedlerResult own = fiedlerVector(W, withSolver(EigenSolver::Sparse));
-    const FiedlerResult eigens = fiedlerVector(W, options);
-    ASSERT_TRUE(own.sparse && eigens.sparse);
-    EXPECT_EQ(own.eigenvalue, eigens.eigenvalue);
-    EXPECT_EQ(own.y, eigens.y);
+    const FiedlerResult given = fiedlerVector(W, options);
+    ASSERT_TRUE(own.sparse && given.sparse);
+    EXPECT_EQ(own.eigenvalue, given.eigenvalue);
+    EXPECT_EQ(own.y, given.y);
   }
+}
+
+TEST(Fiedler, ItsOwnOrderingIsEigensAMDOrderingWhereTheSearchFillsIn) {
+  // A grid of 24 x 24 nodes is all loops: the search's order fills in more
+  // than the 1.5 times the matrix's entries it is allowed, and fiedlerVector
+  // orders by AMD instead, computed without Eigen's AMDOrdering's copies.
+  // Handing it Eigen's AMDOrdering of the same pattern as ranks must give the
+  // very same factor, hence the same bits.
+  const int side = 24;
+  std::vector<WeightedPair> pairs;
+  for (int x = 0; x < side; ++x)
+    for (int y = 0; y < side; ++y) {
+      const int i = x * side + y;
+      if (x + 1 < side) pairs.push_back({i, i + side, 0.5 + 0.01 * ((i * 7) % 11)});
+      if (y + 1 < side) pairs.push_back({i, i + 1, 0.5 + 0.01 * ((i * 3) % 13)});
+    }
+  const WeightMatrix W = buildWeightMatrix(side * side, pairs);
+  const int n = int(W.rows());
+  const WeightMatrix pattern = groundedPattern(W);
+  ASSERT_GT(factorFill(pattern, maximumCardinalityOrder(pattern)), 1.5);
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> amd;
+  Eigen::AMDOrdering<int>()(pattern, amd);
+  FiedlerOptions options = withSolver(EigenSolver::Sparse);
+  options.elimination_rank = ranksOf(amd.indices().data(), n);
+  const FiedlerResult own = fiedlerVector(W, withSolver(EigenSolver::Sparse));
+  const FiedlerResult eigens = fiedlerVector(W, options);
+  ASSERT_TRUE(own.sparse && eigens.sparse);
+  EXPECT_EQ(own.eigenvalue, eigens.eigenvalue);
+  EXPECT_EQ(own.y, eigens.y);
 }
 
 TEST(Fiedler, AWorkspaceReusedAcrossSizesGivesTheBitsOfAFreshSolve) {
