@@ -121,6 +121,28 @@ Permutation maximumCardinalityPermutation(const WeightMatrix& A) {
   return order;
 }
 
+/// Whether the LDL^T factor of `upper` (a symmetric matrix's upper triangle,
+/// in elimination order) holds at most `limit` entries below its diagonal:
+/// the count of SimplicialLDLT's symbolic analysis (each column's entries
+/// found along the elimination tree), without its storage, and stopped as
+/// soon as it passes the limit.
+bool factorFitsWithin(const WeightMatrix& upper, Eigen::Index limit) {
+  const int n = int(upper.cols());
+  std::vector<int> parent(std::size_t(n), -1), tag(std::size_t(n), -1);
+  Eigen::Index entries = 0;
+  for (int k = 0; k < n; ++k) {
+    tag[std::size_t(k)] = k;
+    for (WeightMatrix::InnerIterator it(upper, k); it; ++it) {
+      for (int i = int(it.index()); i < k && tag[std::size_t(i)] != k; i = parent[std::size_t(i)]) {
+        if (parent[std::size_t(i)] == -1) parent[std::size_t(i)] = k;
+        tag[std::size_t(i)] = k;
+        if (++entries > limit) return false;
+      }
+    }
+  }
+  return true;
+}
+
 /// The fill-reducing elimination order of a symmetric matrix, as Eigen's
 /// orderings give it (entry k: the node eliminated k-th): the nodes by
 /// increasing rank when ranks are given (rank[k] for node k; extra entries
@@ -149,11 +171,7 @@ class PreorderedLDLT : public Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, 
     analyzeInOrder(upper);
     factorizeInOrder(upper);
   }
-  /// The factor's pattern; returns its entries below the diagonal.
-  Eigen::Index analyzeInOrder(const WeightMatrix& upper) {
-    analyzePattern_preordered(upper, true);
-    return m_matrix.outerIndexPtr()[m_matrix.outerSize()];
-  }
+  void analyzeInOrder(const WeightMatrix& upper) { analyzePattern_preordered(upper, true); }
   void factorizeInOrder(const WeightMatrix& upper) { factorize_preordered<true>(upper); }
   std::size_t factorBytes() const {
     return std::size_t(m_matrix.data().allocatedSize()) * (sizeof(double) + sizeof(int));
@@ -214,23 +232,24 @@ class DeflatedLaplacianInverse {
     const WeightMatrix& grounded = buffers.grounded;
     withoutLastNode(L, buffers.grounded);
     WeightMatrix& permuted = buffers.permuted;  // upper triangle, in elimination order
-    const auto analyzeIn = [&](Permutation order) {
+    const auto permuteBy = [&](Permutation order) {
       order_ = std::move(order);
       to_eliminated_ = order_.inverse();
       permuted.selfadjointView<Eigen::Upper>() = grounded.selfadjointView<Eigen::Lower>().twistedBy(to_eliminated_);
-      return ldlt_.analyzeInOrder(permuted);
     };
     if (!rank.empty()) {
-      analyzeIn(eliminationOrder(grounded, rank, buffers.pattern));
+      permuteBy(eliminationOrder(grounded, rank, buffers.pattern));
     } else {
       // A node's own order, from its block alone. The blocks of route-like
       // graphs are nearly chordal, where maximum cardinality search orders
       // in linear time with as little fill as AMD or less; AMD where it
       // fills in (a graph of loops).
       const Eigen::Index below_diagonal = (grounded.nonZeros() - grounded.rows()) / 2;
-      const Eigen::Index factor = analyzeIn(maximumCardinalityPermutation(grounded));
-      if (double(factor) > kMaxSearchFill * double(below_diagonal)) analyzeIn(amdOrder(grounded, buffers.pattern));
+      permuteBy(maximumCardinalityPermutation(grounded));
+      if (!factorFitsWithin(permuted, Eigen::Index(kMaxSearchFill * double(below_diagonal))))
+        permuteBy(amdOrder(grounded, buffers.pattern));
     }
+    ldlt_.analyzeInOrder(permuted);
     ldlt_.factorizeInOrder(permuted);
     if (ldlt_.info() != Eigen::Success)
       throw EigenSolverError("Fiedler vector: the grounded Laplacian could not be factorised");
