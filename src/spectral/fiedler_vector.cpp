@@ -167,10 +167,6 @@ Permutation eliminationOrder(const WeightMatrix& A, const std::vector<int>& rank
 /// the matrix itself: the same factor, without the copies.
 class PreorderedLDLT : public Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> {
  public:
-  void computeInOrder(const WeightMatrix& upper) {
-    analyzeInOrder(upper);
-    factorizeInOrder(upper);
-  }
   void analyzeInOrder(const WeightMatrix& upper) { analyzePattern_preordered(upper, true); }
   void factorizeInOrder(const WeightMatrix& upper) { factorize_preordered<true>(upper); }
   std::size_t factorBytes() const {
@@ -211,8 +207,8 @@ using Buffers = FiedlerWorkspace::Buffers;
 /// The order of maximum cardinality search is kept while the factor holds at
 /// most this many times the entries of the matrix below its diagonal, else
 /// the node is ordered by AMD. On the 1,001-scan stream's blocks the search
-/// filled in 0.5% (AMD 1.2%); on the real logs' sparse solves 12-55% (AMD
-/// 2-43%).
+/// filled in 0.5% (AMD 1.2%); on the sparse solves of six real logs 2-55%
+/// (AMD 2-43%); on a grid of loops far more (a test).
 constexpr double kMaxSearchFill = 1.5;
 
 /// Spectra operator for P L^+ P, where P projects out z0 = D^1/2 1 (the known
