@@ -8,6 +8,7 @@
 #include "to_cloud.h"
 
 #include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/maps/odometry_correction.h>
 
 #include <pcl/point_types.h>
 
@@ -332,4 +333,108 @@ TEST(Refinement, AWholeLaterVisitAFewCentimetresOffIsBroughtBack) {
     EXPECT_LE(t, 0.005) << toString(r);
     EXPECT_LE(angle, 0.1 * kDeg) << toString(r);
   }
+}
+
+// Odometry corrected by scan matching before the grouping
+// (maps/odometry_correction.h): drifted poses come close to the truth,
+// exact poses are kept bit for bit, the result does not depend on the
+// thread count, and 3D clouds keep their poses unless asked.
+namespace {
+
+struct OfficeRoute {
+  std::vector<Observation<pcl::PointXYZ>> observations;  ///< at the true poses
+  std::vector<Eigen::Isometry3d> truth;
+};
+
+OfficeRoute officeRoute(sim::Sensor sensor) {
+  const sim::Building office = sim::makeBuilding("office");
+  OfficeRoute r;
+  for (std::size_t k = 0; k < office.route.size(); ++k) {
+    const sim::Pose2D& pose = office.route[k];
+    Cloud::Ptr cloud = sensor == sim::Sensor::Depth
+                           ? sim::depthCloud<pcl::PointXYZ>(office.plan, pose, sim::depthCamera(), k)
+                           : sim::scanCloud<pcl::PointXYZ>(office.plan, pose, sim::laser360(), k);
+    r.truth.push_back(sim::toIsometry(pose, sim::sensorHeight(sensor)));
+    r.observations.push_back({cloud, r.truth.back()});
+  }
+  return r;
+}
+
+std::vector<Eigen::Isometry3d> posesOf(const std::vector<Observation<pcl::PointXYZ>>& observations) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (const auto& o : observations) poses.push_back(o.pose);
+  return poses;
+}
+
+}  // namespace
+
+TEST(OdometryCorrection, DriftedPosesOfALaserComeBackToTheTruth) {
+  OfficeRoute route = officeRoute(sim::Sensor::Laser360);
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(route.truth, 7);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  const double before = sim::rmsPositionError(drifted, route.truth);
+  ASSERT_GT(before, 0.5);
+  const OdometryCorrectionReport report = correctOdometry(route.observations, OdometryCorrection::Auto);
+  EXPECT_TRUE(report.applied);
+  EXPECT_GT(report.matched, report.steps / 2);
+  EXPECT_LT(report.corrected_cells, report.input_cells);
+  const double after = sim::rmsPositionError(posesOf(route.observations), route.truth);
+  EXPECT_LT(after, 0.25 * before) << before << " m before";
+  EXPECT_LT(after, 0.2);
+  for (const auto& pose : posesOf(route.observations)) {  // still a ground robot's: SE(2)
+    EXPECT_EQ(pose.translation().z(), 0.0);
+    EXPECT_NEAR(pose.linear()(2, 2), 1.0, 1e-9);
+  }
+}
+
+TEST(OdometryCorrection, ExactPosesAreKeptBitForBit) {
+  OfficeRoute route = officeRoute(sim::Sensor::Laser360);
+  const OdometryCorrectionReport report = correctOdometry(route.observations, OdometryCorrection::Auto);
+  EXPECT_FALSE(report.applied);
+  EXPECT_GT(report.sampled, 0);
+  EXPECT_EQ(report.sample_matched, 0);
+  for (std::size_t k = 0; k < route.truth.size(); ++k)
+    EXPECT_TRUE(route.observations[k].pose.matrix() == route.truth[k].matrix()) << k;
+  // Off touches nothing, whatever the poses.
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(route.truth, 7);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  EXPECT_EQ(correctOdometry(route.observations, OdometryCorrection::Off).steps, 0);
+  for (std::size_t k = 0; k < drifted.size(); ++k)
+    EXPECT_TRUE(route.observations[k].pose.matrix() == drifted[k].matrix()) << k;
+}
+
+TEST(OdometryCorrection, TheCorrectionIsTheSameForAnyThreadCount) {
+  OfficeRoute route = officeRoute(sim::Sensor::Laser360);
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(route.truth, 11);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  std::vector<std::vector<Eigen::Isometry3d>> results;
+  for (int threads : {1, 2, 3}) {
+    auto observations = route.observations;
+    OdometryCorrectionParameters parameters;
+    parameters.threads = threads;
+    correctOdometry(observations, OdometryCorrection::On, parameters);
+    results.push_back(posesOf(observations));
+  }
+  for (std::size_t k = 0; k < drifted.size(); ++k) {
+    EXPECT_TRUE(results[0][k].matrix() == results[1][k].matrix()) << k;
+    EXPECT_TRUE(results[0][k].matrix() == results[2][k].matrix()) << k;
+  }
+}
+
+TEST(OdometryCorrection, DepthCloudsKeepTheirPosesInAutoMode) {
+  OfficeRoute route = officeRoute(sim::Sensor::Depth);
+  route.observations.resize(20);
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(std::vector<Eigen::Isometry3d>(route.truth.begin(), route.truth.begin() + 20), 7);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  const OdometryCorrectionReport report = correctOdometry(route.observations, OdometryCorrection::Auto);
+  EXPECT_FALSE(report.applied);
+  EXPECT_EQ(report.steps, 0);
+  for (std::size_t k = 0; k < drifted.size(); ++k)
+    EXPECT_TRUE(route.observations[k].pose.matrix() == drifted[k].matrix()) << k;
+}
+
+TEST(OdometryCorrection, ModesAreNamedAsTheCommandLineSpellsThem) {
+  EXPECT_EQ(odometryCorrectionFromString("auto"), OdometryCorrection::Auto);
+  EXPECT_EQ(toString(OdometryCorrection::Off), "off");
+  EXPECT_THROW(odometryCorrectionFromString("sometimes"), std::invalid_argument);
 }

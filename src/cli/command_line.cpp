@@ -194,7 +194,7 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                    "the paper's method exactly: --sso " + toString(paper.model) + " --split " + toString(paper.split) +
                        " --ncut-threshold " + number(paper.ncut_threshold) + " --boundary-passes " +
                        std::to_string(paper.boundary_passes) + " --mutual-neighbours " +
-                       std::to_string(paper.mutual_neighbours) + " (delta as given)")
+                       std::to_string(paper.mutual_neighbours) + " --correct-odometry off (delta as given)")
       ->group("Sensed-space model");
   command.add_option("--cell", args.method.regions.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(finiteNumber(0.0, true))
@@ -282,6 +282,13 @@ void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
       ->check(wholeNumber(0))
       ->capture_default_str();
+  command.add_option("--correct-odometry", args.correct_odometry,
+                     "scan-match each observation to the one before it and group at the corrected poses: auto (2D "
+                     "scans, when the corrected map is sharper: drifted odometry), on or off (default: " +
+                         toString(args.correct_odometry) + ")")
+      ->transform(oneOf(kOdometryCorrectionNames))
+      ->option_text(choices(kOdometryCorrectionNames))
+      ->group("Partition");
   command.add_option("--refine", args.refine,
                      "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios) (default: " +
                          toString(args.refine) + ")")
@@ -495,7 +502,10 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
     for (const char* option : {"--mutual-neighbours", "--mutual-neighbours-share"})
       if (partition.count(option))
         return std::string("--paper uses every overlap (--mutual-neighbours 0); drop ") + option;
+    if (partition.count("--correct-odometry") && args.correct_odometry != obsgroup::OdometryCorrection::Off)
+      return "--paper groups at the input poses (--correct-odometry off); drop one of them";
     args.method.usePaperMethod();
+    args.correct_odometry = obsgroup::OdometryCorrection::Off;
   }
   if (partition.count("--mutual-neighbours-share") && args.method.mutual_neighbours == 0)
     return "--mutual-neighbours-share applies when --mutual-neighbours is above 0";

@@ -25,6 +25,7 @@
 #include <obsgroup/io/pose_file.h>
 #include <obsgroup/places/localize.h>
 #include <obsgroup/partition/keyframes.h>
+
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
@@ -346,6 +347,7 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
   p["diagonal"] = method.diagonal_weight;
   p["map_voxel"] = map_voxel;
   p["refine"] = toString(args.refine);
+  p["correct_odometry"] = toString(args.correct_odometry);
   return p;
 }
 
@@ -585,6 +587,16 @@ void printWritten(const PartitionArgs& args) {
                args.pictures ? ", map.png/.svg, weights.png, fiedler.png, local_maps/group_NNN.png" : "");
 }
 
+/// One line saying the poses were corrected, if they were.
+void printOdometryCorrection(const io::RunRecord& run) {
+  const auto& s = run.statistics;
+  if (!s.contains("odometry_correction") || !s.at("odometry_correction").at("applied").get<bool>()) return;
+  const auto& c = s.at("odometry_correction");
+  std::fprintf(stderr, "  poses corrected by scan matching: %d of %d steps changed (map %zu cells, %zu at the input poses)\n",
+               c.at("matched").get<int>(), c.at("steps").get<int>(), c.at("corrected_map_cells").get<std::size_t>(),
+               c.at("input_map_cells").get<std::size_t>());
+}
+
 void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
   const auto& s = run.statistics;
   const auto& t = run.timing_s;
@@ -599,6 +611,7 @@ void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size
                plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(), t.at("overlap").get<double>(),
                t.at("graph").get<double>(), t.at("partition").get<double>(), t.at("local_maps").get<double>(),
                t.at("outputs").get<double>(), t.at("pictures").get<double>());
+  printOdometryCorrection(run);
   printWritten(args);
 }
 
@@ -613,6 +626,7 @@ void printStreamSummary(const PartitionArgs& args, const io::RunRecord& run, std
                plural(s.at("groups").get<std::size_t>(), "group").c_str(), t.at("load").get<double>(),
                t.at("stream").get<double>(), t.at("local_maps").get<double>(), t.at("outputs").get<double>(),
                t.at("pictures").get<double>());
+  printOdometryCorrection(run);
   printWritten(args);
 }
 
@@ -763,6 +777,29 @@ std::vector<int> keepKeyframes(const PartitionArgs& args, std::vector<Observatio
   return keyframe_of;
 }
 
+/// --correct-odometry: the observations' poses corrected by scan matching
+/// (in place, when the mode and the maps' sharpness say so); what
+/// partition.json records of it, null when off.
+template <typename PointT>
+nlohmann::json correctPoses(const PartitionArgs& args, std::vector<Observation<PointT>>& observations, double& seconds) {
+  if (args.correct_odometry == OdometryCorrection::Off) return nullptr;
+  const Clock::time_point start = Clock::now();
+  OdometryCorrectionParameters parameters;
+  parameters.threads = args.method.threads;
+  const OdometryCorrectionReport r = correctOdometry(observations, args.correct_odometry, parameters);
+  throwIfInterrupted(args.interrupt);
+  seconds = secondsSince(start);
+  return {{"applied", r.applied},
+          {"steps", r.steps},
+          {"matched", r.matched},
+          {"kept", r.kept},
+          {"unaligned", r.unaligned},
+          {"sampled", r.sampled},
+          {"sample_matched", r.sample_matched},
+          {"input_map_cells", r.input_cells},
+          {"corrected_map_cells", r.corrected_cells}};
+}
+
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
   if (args.locate) return locateObservations(args, observations, input);
@@ -772,6 +809,8 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   const std::vector<std::string> sources = input.labels;
   const std::vector<double> stamps = input.stamps;
   const std::vector<int> keyframe_of = keepKeyframes(args, observations, input);
+  double odometry_seconds = 0;
+  const nlohmann::json odometry = correctPoses(args, observations, odometry_seconds);
   GroupingOutcome<PointT> grouped;
   configureGrouping(args, grouped.grouping);
   if (args.stream)
@@ -787,6 +826,10 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
       keyframe_of.empty() ? grouped.partition : expandKeyframePartition(grouped.partition, keyframe_of);
   const OutputTimes written = writeResults(args, out, grouped, observations, maps, of_every_frame, warn);
   io::RunRecord run = runRecord(args, input, grouped, maps, written, warn);
+  if (!odometry.is_null()) {
+    run.statistics["odometry_correction"] = odometry;
+    run.timing_s["odometry_correction"] = odometry_seconds;
+  }
   run.sources = sources;
   run.stamps = stamps;
   run.keyframe_of = keyframe_of;

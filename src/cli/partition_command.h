@@ -10,6 +10,7 @@
 #include <obsgroup/grouping_parameters.h>
 #include <obsgroup/partition/keyframes.h>
 #include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/maps/odometry_correction.h>
 #include "progress_bar.h"
 
 #include <nlohmann/json.hpp>
@@ -82,6 +83,8 @@ struct PartitionArgs {
   /// much since the last keyframe are grouped; the others join their keyframe.
   std::optional<KeyframeOptions> keyframes;
   Refinement refine = Refinement::None;
+  /// Scan matching of the input poses before grouping; --paper: off.
+  OdometryCorrection correct_odometry = OdometryCorrection::Auto;
   bool paper = false;         ///< --paper: the preset, applied by the command line
   std::vector<double> band;  ///< --band LOW HIGH as given (then in `method.regions`)
   // the run

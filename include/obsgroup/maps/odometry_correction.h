@@ -1,0 +1,137 @@
+#pragma once
+/// \file
+/// Odometry corrected by scan matching, before the grouping. Drifted
+/// odometry draws a room's walls twice and lets scans of one room see each
+/// other's floor in the wrong place, so their overlap (eq. 16-18) no longer
+/// says which scans share a room. Each observation is aligned with the one
+/// before it, from the step the input poses give (the pairwise aligner of
+/// refinement, docs/refinement.md), and the matched step replaces the
+/// input's where it puts the observation's points demonstrably better on
+/// its predecessor's surfaces. In `Auto` mode the corrected trajectory is
+/// kept only when the map it draws is sharper than the input's: a log whose
+/// poses a SLAM back-end already corrected, loop closures and all, keeps
+/// them (chaining matched steps would undo the closures).
+
+#include "obsgroup/cloud/finite_points.h"
+#include "obsgroup/cloud/observation.h"
+#include "obsgroup/common/enum_names.h"
+#include "obsgroup/maps/refinement.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace obsgroup {
+
+/// Whether the input poses are corrected by scan matching before grouping.
+enum class OdometryCorrection {
+  Off,   ///< Keep the input poses.
+  /// Planar scans: a sample of the steps is matched first, and poses it
+  /// leaves as they are are kept; otherwise every step is matched, and the
+  /// corrected poses are kept when their map is sharper (fewer occupied
+  /// cells) than the input's. 3D clouds keep the input poses.
+  Auto,
+  On  ///< Always the corrected poses (planar scans and 3D clouds).
+};
+
+inline constexpr EnumName<OdometryCorrection> kOdometryCorrectionNames[] = {
+    {OdometryCorrection::Off, "off"}, {OdometryCorrection::Auto, "auto"}, {OdometryCorrection::On, "on"}};
+
+inline std::string toString(OdometryCorrection mode) { return nameOf(kOdometryCorrectionNames, mode); }
+/// Parses "off", "auto" or "on"; throws std::invalid_argument otherwise.
+inline OdometryCorrection odometryCorrectionFromString(const std::string& name) {
+  return valueNamed(kOdometryCorrectionNames, name, "odometry correction");
+}
+
+struct OdometryCorrectionParameters {
+  /// The pairwise aligner's parameters (thinning voxel, gates, bounds of a
+  /// step's correction: 1.2 m and 20 degrees for planar scans).
+  RefinementParameters alignment;
+  /// A matched step replaces the input's only when it raises the soft share
+  /// of the observation's points on its predecessor's surfaces by this much
+  /// (exact poses then stay bit for bit as given).
+  double min_gain = 0.02;
+  /// Auto: the maps are compared by their occupied cells of this size, metres
+  /// (the visibility regions' cell)...
+  double map_cell = 0.2;
+  /// ...and the corrected poses are kept when their map occupies at most this
+  /// share of the input map's cells. Measured: drifted simulated runs of real
+  /// floor plans 0.37-0.72, SLAM-corrected real logs 1.14-1.75 (docs/method.md).
+  double max_cell_ratio = 0.9;
+  /// Auto: about this many steps, evenly spread, are matched first...
+  int sample_steps = 100;
+  /// ...and the rest only when at least this share of them changed.
+  double min_sample_share = 0.1;
+  int threads = 0;  ///< 0: all cores; the result does not depend on it
+};
+
+/// What the correction did.
+struct OdometryCorrectionReport {
+  int steps = 0;      ///< observations after the first
+  int matched = 0;    ///< steps the scan matching changed
+  int kept = 0;       ///< input steps kept: the match was no better
+  int unaligned = 0;  ///< input steps kept: the pair did not align
+  int sampled = 0;         ///< Auto: steps matched first, as a sample...
+  int sample_matched = 0;  ///< ...and how many of them changed
+  std::size_t input_cells = 0;      ///< occupied cells of the input poses' map
+  std::size_t corrected_cells = 0;  ///< ... and of the corrected poses' map
+  bool applied = false;             ///< the corrected poses replaced the input's
+};
+
+/// Observation i's finite points in its sensor frame, made when asked for:
+/// a long log's points are not copied all at once.
+using PointsOfObservation = std::function<MemberPoints(std::size_t)>;
+
+/// The poses each observation's scan matching gives: the first pose is kept,
+/// every later one is its predecessor's corrected pose times the matched (or
+/// the input) step. `planar`: every point lies in the sensor's plane (2D scans).
+std::vector<Eigen::Isometry3d> scanMatchedPoses(const PointsOfObservation& points,
+                                                const std::vector<Eigen::Isometry3d>& poses, bool planar,
+                                                const OdometryCorrectionParameters& parameters,
+                                                OdometryCorrectionReport& report);
+
+/// Occupied cells of `cell` metres (squares in the xy plane for planar
+/// scans, cubes otherwise) of every point at `poses`: fewer is a sharper map.
+std::size_t occupiedCells(const PointsOfObservation& points, const std::vector<Eigen::Isometry3d>& poses,
+                          double cell, bool planar);
+
+/// Corrects `poses` in place as `mode` says; returns what was done.
+OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std::vector<Eigen::Isometry3d>& poses,
+                                         bool planar, OdometryCorrection mode,
+                                         const OdometryCorrectionParameters& parameters = {});
+
+/// The same for observations: their poses are corrected in place.
+template <typename PointT>
+OdometryCorrectionReport correctOdometry(std::vector<Observation<PointT>>& observations, OdometryCorrection mode,
+                                         const OdometryCorrectionParameters& parameters = {}) {
+  if (mode == OdometryCorrection::Off || observations.size() < 2) return {};
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(observations.size());
+  bool planar = true;  // every point in one plane of the sensor: a 2D scan
+  bool first = true;
+  float plane = 0.0f;
+  for (const auto& observation : observations) {
+    for (const PointT& p : observation.cloud->points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      if (first) plane = p.z;
+      first = false;
+      planar = planar && p.z == plane;
+    }
+    poses.push_back(observation.pose);
+  }
+  const PointsOfObservation points = [&observations](std::size_t i) {
+    MemberPoints out;
+    for (const PointT& p : finitePoints(*observations[i].cloud).points) out.emplace_back(p.x, p.y, p.z);
+    return out;
+  };
+  const OdometryCorrectionReport report = correctOdometry(points, poses, planar, mode, parameters);
+  if (report.applied)
+    for (std::size_t i = 0; i < observations.size(); ++i) observations[i].pose = poses[i];
+  return report;
+}
+
+}  // namespace obsgroup

@@ -1,0 +1,188 @@
+#include "obsgroup/maps/odometry_correction.h"
+
+#include "refinement/pair_aligner.h"
+#include "refinement/prepared_member.h"
+#include "refinement/se3.h"
+
+#include "obsgroup/common/parallel_for.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <unordered_set>
+
+namespace obsgroup {
+
+using namespace refinement;
+
+namespace {
+
+/// Soft share of `source`'s points on `target`'s surfaces with the source at
+/// `pose` in the target's frame, as refinement weighs a member's consistency:
+/// each point counts 1 - (r / inlier)^2 for its match (0 beyond), times what
+/// the match says about a ground robot's x, y and yaw.
+double consistencyAt(const PreparedMember& source, const PreparedMember& target, const Eigen::Isometry3d& pose,
+                     bool planar, double inlier) {
+  const auto& points = source.cloud->points;
+  if (points.empty()) return 0;
+  flann::KNNSimpleResultSet<float> nearest(1);
+  double sum = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    double r;
+    Eigen::Vector3d n;
+    if (residual(target, pose * points[i].getVector3fMap().cast<double>(), pose.linear() * source.normals[i],
+                 3 * inlier, r, n, nearest))
+      sum += std::max(0.0, 1.0 - (r / inlier) * (r / inlier)) * (planar ? n.head<2>().squaredNorm() : 1.0);
+  }
+  return sum / double(points.size());
+}
+
+enum class StepOutcome { Matched, Kept, Unaligned };
+
+/// The step from the previous observation to `current`: the matched one
+/// when it aligns and is better by min_gain, else the input's.
+StepOutcome correctStep(const PreparedMember& current, const PreparedMember& previous, const Eigen::Isometry3d& input_step,
+                        const Freedom& freedom, const OdometryCorrectionParameters& parameters, Eigen::Isometry3d& step) {
+  step = input_step;
+  if (!current.index || !previous.index) return StepOutcome::Unaligned;
+  const RefinementParameters& alignment = parameters.alignment;
+  const PairAlignment pair = alignPair(current, previous, input_step, freedom, alignment);
+  if (!pair.usable) return StepOutcome::Unaligned;
+  const double inlier = alignment.inlier_distance;
+  if (!(consistencyAt(current, previous, pair.pose, freedom.planar, inlier) >
+        consistencyAt(current, previous, input_step, freedom.planar, inlier) + parameters.min_gain))
+    return StepOutcome::Kept;
+  step = pair.pose;
+  return StepOutcome::Matched;
+}
+
+/// Scan matching of the steps into observations `targets` (each from the
+/// one before it). Steps are independent, each from the input's: the
+/// result does not depend on the thread count.
+class StepMatcher {
+ public:
+  StepMatcher(const PointsOfObservation& points, const std::vector<Eigen::Isometry3d>& poses, bool planar,
+              const OdometryCorrectionParameters& parameters)
+      : points_(points), poses_(poses), planar_(planar), freedom_(planar && posesArePlanar(poses)),
+        parameters_(parameters) {
+    const RefinementParameters& given = parameters.alignment;
+    voxel_ = planar ? given.alignment_voxel : given.alignment_voxel_3d;
+    if (!planar) {  // 3D clouds: refinement's narrower gate and bounds
+      parameters_.alignment.max_correspondence_distance = given.max_correspondence_distance_3d;
+      parameters_.alignment.max_translation_correction = given.max_translation_correction_3d;
+      parameters_.alignment.max_rotation_correction = given.max_rotation_correction_3d;
+    }
+    steps_.assign(poses.size(), Eigen::Isometry3d::Identity());
+    outcomes_.assign(poses.size(), StepOutcome::Kept);
+  }
+
+  /// Matches the steps into observations first, first + 1, ..., last - 1,
+  /// each observation prepared once.
+  void matchRun(std::size_t first, std::size_t last) {
+    std::unique_ptr<PreparedMember> previous = prepare(points_(first - 1), voxel_, planar_);
+    for (std::size_t i = first; i < last; ++i) {
+      std::unique_ptr<PreparedMember> current = prepare(points_(i), voxel_, planar_);
+      outcomes_[i] = correctStep(*current, *previous, poses_[i - 1].inverse() * poses_[i], freedom_, parameters_, steps_[i]);
+      previous = std::move(current);
+    }
+  }
+
+  /// Every step, in contiguous runs over `threads` threads.
+  void matchAll(int threads) {
+    const std::size_t n = poses_.size() - 1;
+    const std::size_t runs = std::min<std::size_t>(n, 64);
+    parallelFor(runs, threads, [&](std::size_t r) { matchRun(1 + n * r / runs, 1 + n * (r + 1) / runs); });
+  }
+
+  /// Every `stride`-th step only; returns how many it matched of how many.
+  std::pair<int, int> matchSample(std::size_t stride, int threads) {
+    std::vector<std::size_t> sample;
+    for (std::size_t i = 1; i < poses_.size(); i += stride) sample.push_back(i);
+    parallelFor(sample.size(), threads, 8, [&](std::size_t k) { matchRun(sample[k], sample[k] + 1); });
+    int matched = 0;
+    for (std::size_t i : sample) matched += outcomes_[i] == StepOutcome::Matched;
+    return {matched, static_cast<int>(sample.size())};
+  }
+
+  /// The poses chained from the first through every step; counts the outcomes.
+  std::vector<Eigen::Isometry3d> chained(OdometryCorrectionReport& report) const {
+    std::vector<Eigen::Isometry3d> corrected = poses_;
+    for (std::size_t i = 1; i < poses_.size(); ++i) {
+      corrected[i] = corrected[i - 1] * steps_[i];
+      ++report.steps;
+      report.matched += outcomes_[i] == StepOutcome::Matched;
+      report.kept += outcomes_[i] == StepOutcome::Kept;
+      report.unaligned += outcomes_[i] == StepOutcome::Unaligned;
+    }
+    return corrected;
+  }
+
+ private:
+  const PointsOfObservation& points_;
+  const std::vector<Eigen::Isometry3d>& poses_;
+  const bool planar_;
+  const Freedom freedom_;  // SE(2) when the poses are a ground robot's too: z, roll and pitch stay as given
+  OdometryCorrectionParameters parameters_;
+  double voxel_ = 0;
+  std::vector<Eigen::Isometry3d> steps_;
+  std::vector<StepOutcome> outcomes_;
+};
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> scanMatchedPoses(const PointsOfObservation& points,
+                                                const std::vector<Eigen::Isometry3d>& poses, bool planar,
+                                                const OdometryCorrectionParameters& parameters,
+                                                OdometryCorrectionReport& report) {
+  if (poses.size() < 2) return poses;
+  StepMatcher matcher(points, poses, planar, parameters);
+  matcher.matchAll(parameters.threads);
+  return matcher.chained(report);
+}
+
+std::size_t occupiedCells(const PointsOfObservation& points, const std::vector<Eigen::Isometry3d>& poses,
+                          double cell, bool planar) {
+  std::unordered_set<std::uint64_t> cells;
+  const auto key = [cell](double v) { return std::uint64_t(std::int64_t(std::floor(v / cell))) & 0x1FFFFF; };
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (const Eigen::Vector3f& p : points(i)) {
+      const Eigen::Vector3d w = poses[i] * p.cast<double>();
+      // 21 bits per axis: cells 0.2 m apart repeat every 419 km, beyond any building.
+      cells.insert(key(w.x()) << 42 | key(w.y()) << 21 | (planar ? 0 : key(w.z())));
+    }
+  return cells.size();
+}
+
+OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std::vector<Eigen::Isometry3d>& poses,
+                                         bool planar, OdometryCorrection mode,
+                                         const OdometryCorrectionParameters& parameters) {
+  OdometryCorrectionReport report;
+  if (mode == OdometryCorrection::Off || poses.size() < 2) return report;
+  if (mode == OdometryCorrection::Auto && !planar) return report;
+  StepMatcher matcher(points, poses, planar, parameters);
+  if (mode == OdometryCorrection::Auto) {
+    // Poses that scan matching leaves as they are on a sample of the steps
+    // (exact poses: none changes) are not matched at all: a long log of
+    // consistent poses pays for the sample only.
+    const std::size_t steps = poses.size() - 1;
+    const std::size_t stride = std::max<std::size_t>(1, steps / std::max(1, parameters.sample_steps));
+    const auto [matched, sampled] = matcher.matchSample(stride, parameters.threads);
+    report.sampled = sampled;
+    report.sample_matched = matched;
+    if (double(matched) < parameters.min_sample_share * double(sampled)) {
+      report.steps = static_cast<int>(steps);
+      return report;
+    }
+  }
+  matcher.matchAll(parameters.threads);
+  std::vector<Eigen::Isometry3d> corrected = matcher.chained(report);
+  report.input_cells = occupiedCells(points, poses, parameters.map_cell, planar);
+  report.corrected_cells = occupiedCells(points, corrected, parameters.map_cell, planar);
+  report.applied = mode == OdometryCorrection::On ||
+                   double(report.corrected_cells) <= parameters.max_cell_ratio * double(report.input_cells);
+  if (report.applied) poses = std::move(corrected);
+  return report;
+}
+
+}  // namespace obsgroup
