@@ -283,8 +283,8 @@ void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->check(wholeNumber(0))
       ->capture_default_str();
   command.add_option("--correct-odometry", args.correct_odometry,
-                     "scan-match each observation to the one before it and group at the corrected poses: auto (2D "
-                     "scans, when the corrected map is sharper: drifted odometry), on or off (default: " +
+                     "scan-match each observation to the one before it and group at the corrected poses: auto (when "
+                     "the corrected map is sharper: drifted odometry), on or off (default: " +
                          toString(args.correct_odometry) + ")")
       ->transform(oneOf(kOdometryCorrectionNames))
       ->option_text(choices(kOdometryCorrectionNames))
