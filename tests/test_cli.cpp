@@ -1877,6 +1877,51 @@ TEST_F(Cli, LocateFindsEachObservationsPlaceAndRefusesWhatItCannotUse) {
   EXPECT_NE(damaged.err.find("places.png"), std::string::npos) << damaged.err;
 }
 
+TEST_F(Cli, DriftedOdometryIsCorrectedBeforeGroupingAndLocating) {
+  // sena_odometry's poses are a robot's raw odometry: partition groups at
+  // the scan-matched poses, and locate corrects the same log the same way,
+  // so each observation lies in its own group's place; at the raw poses it
+  // does not, unless tracked against the map.
+  const std::string input = kData + "/real/sena_odometry/sena_odometry.clf";
+  const fs::path run1 = dir_ / "run1";
+  const Result grouped = run("partition " + input + " --no-pictures -o " + run1.string());
+  ASSERT_EQ(grouped.code, 0) << grouped.err;
+  EXPECT_NE(grouped.err.find("poses corrected by scan matching"), std::string::npos) << grouped.err;
+  const nlohmann::json partition = readJson(run1 / "partition.json");
+  const nlohmann::json& correction = partition.at("statistics").at("odometry_correction");
+  EXPECT_TRUE(correction.at("applied").get<bool>());
+  EXPECT_LT(correction.at("corrected_map_cells").get<double>(), 0.5 * correction.at("input_map_cells").get<double>());
+  EXPECT_EQ(partition.at("parameters").at("correct_odometry"), "auto");
+  std::map<int, int> place_of;
+  for (std::size_t g = 0; g < partition.at("groups").size(); ++g)
+    for (int i : partition.at("groups")[g]) place_of[i] = partition.at("place_ids")[g];
+  const auto ownPlaces = [&](const std::string& options) {
+    const fs::path located = dir_ / "located.json";
+    const Result r = run("locate " + run1.string() + " " + input + " -q --force " + options + " -o " + located.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    const nlohmann::json locations = readJson(located).at("locations");
+    int own = 0;
+    for (const auto& l : locations) own += l.at("place") == place_of.at(l.at("observation").get<int>());
+    return own;
+  };
+  EXPECT_EQ(ownPlaces(""), 224);
+  EXPECT_EQ(ownPlaces("--no-track"), 224);
+  EXPECT_LT(ownPlaces("--correct-odometry off --no-track"), 200);
+  // Tracked against the map, the raw odometry follows it too.
+  EXPECT_GT(ownPlaces("--correct-odometry off"), 210);
+  // Exact poses are not touched: the shipped office's groups with the correction off are the same.
+  const fs::path exact_on = dir_ / "exact_on", exact_off = dir_ / "exact_off";
+  ASSERT_EQ(run("partition " + kData + "/office_2d/office.clf -q --no-pictures -o " + exact_on.string()).code, 0);
+  ASSERT_EQ(run("partition " + kData + "/office_2d/office.clf -q --no-pictures --correct-odometry off -o " +
+                exact_off.string()).code, 0);
+  EXPECT_EQ(readJson(exact_on / "partition.json").at("groups"), readJson(exact_off / "partition.json").at("groups"));
+  EXPECT_FALSE(readJson(exact_on / "partition.json").at("statistics").at("odometry_correction").at("applied").get<bool>());
+  // --paper groups at the poses given, and says so when asked for both.
+  const Result both = run("partition " + input + " --paper --correct-odometry auto -o " + (dir_ / "p").string());
+  EXPECT_EQ(both.code, 2);
+  EXPECT_NE(both.err.find("--paper groups at the input poses"), std::string::npos) << both.err;
+}
+
 TEST_F(Cli, LocateAlignsAnOffsetRunToItsPlacesLocalMaps) {
   // Run 1 at the true poses; run 2 the same depth frames with every pose 0.29 m off.
   const fs::path run1 = dir_ / "run1";

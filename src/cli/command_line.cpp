@@ -277,11 +277,8 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->group("Partition");
 }
 
-/// Threads, refinement, local maps and the outputs.
-void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
-  command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
-      ->check(wholeNumber(0))
-      ->capture_default_str();
+/// --correct-odometry, for the commands that read poses.
+void addOdometryCorrectionOption(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--correct-odometry", args.correct_odometry,
                      "scan-match each observation to the one before it and group at the corrected poses: auto (when "
                      "the corrected map is sharper: drifted odometry), on or off (default: " +
@@ -289,6 +286,14 @@ void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->transform(oneOf(kOdometryCorrectionNames))
       ->option_text(choices(kOdometryCorrectionNames))
       ->group("Partition");
+}
+
+/// Threads, refinement, local maps and the outputs.
+void addRunOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
+  command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
+      ->check(wholeNumber(0))
+      ->capture_default_str();
+  addOdometryCorrectionOption(command, args);
   command.add_option("--refine", args.refine,
                      "align each local map's observations: none, icp (spanning tree) or lum (Lu & Milios) (default: " +
                          toString(args.refine) + ")")
@@ -370,9 +375,14 @@ void addLocateOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args, obs
                      "a pose on no place takes the nearest place within this, metres (0: none)")
       ->check(finiteNumber(0.0))
       ->capture_default_str();
+  addOdometryCorrectionOption(command, args);
   command.add_flag("--align", locate.align,
                    "align each located observation to its place's local map (ICP from its pose) and report the "
                    "aligned pose, its place and the fit");
+  command.add_flag("--track,!--no-track", locate.track,
+                   "align each observation in turn to its place's local map, from the previous one's aligned pose "
+                   "moved by the input's step, and locate it at that pose: a drifted run follows the map (default; "
+                   "--no-track: each observation at its own pose)");
   command.add_option("--threads", args.method.threads, "threads (0 = all cores); results do not depend on it")
       ->check(wholeNumber(0))
       ->capture_default_str();

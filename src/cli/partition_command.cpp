@@ -706,24 +706,45 @@ nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
 }
 
 /// `obsgroup locate`: each observation's place in the places of a run.
+/// True for a ground robot's pose: in the plane z = 0, turned about z only.
+bool isPlanarPose(const Eigen::Isometry3d& pose) {
+  const Eigen::Matrix3d& R = pose.linear();
+  return std::abs(R(2, 2) - 1) < 1e-9 && std::abs(pose.translation().z()) < 1e-9;
+}
+
+/// The x, y and heading of `pose`, as a pose in the plane z = 0 (ICP on a
+/// planar scan leaves z, roll and pitch unconstrained).
+Eigen::Isometry3d planarPart(const Eigen::Isometry3d& pose) {
+  return pose2D(pose.translation().x(), pose.translation().y(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)));
+}
+
 template <typename PointT>
 int locateObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
-                       const InputRecord& input) {
+                       const InputRecord& input, const nlohmann::json& odometry) {
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
   const PlaceMap places = io::readPlaceLabels(args.locate->places);
   std::optional<PlaceLocalMaps<PointT>> maps;
-  if (args.locate->align) maps.emplace(args.locate->places);
+  const bool track = args.locate->track;
+  if (args.locate->align || track) maps.emplace(args.locate->places);
+  bool planar = true;  // a ground robot's poses: the tracked pose stays in SE(2)
+  for (const auto& o : observations) planar = planar && isPlanarPose(o.pose);
+  Eigen::Isometry3d tracked = Eigen::Isometry3d::Identity();
+  std::size_t followed = 0;
   const double tolerance = args.locate->tolerance;
   std::string text = "{\"places\": " + nlohmann::json(args.locate->places).dump() +
-                     ", \"tolerance_m\": " + nlohmann::json(tolerance).dump() + ",\n \"locations\": [";
+                     ", \"tolerance_m\": " + nlohmann::json(tolerance).dump() + ",\n" +
+                     (odometry.is_null() ? "" : " \"odometry_correction\": " + odometry.dump() + ",\n") +
+                     " \"locations\": [";
   std::size_t inside = 0, near = 0, converged = 0;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     throwIfInterrupted(args.interrupt);
-    const Eigen::Vector2d position = observations[i].pose.translation().template head<2>();
-    const Location at = places.locate(position, tolerance);
-    inside += at.place && at.distance_m == 0;
-    near += at.place && at.distance_m > 0;
+    // Tracking: the previous observation's aligned pose, moved by the input's step.
+    const Eigen::Isometry3d pose =
+        track && i > 0 ? tracked * (observations[i - 1].pose.inverse() * observations[i].pose) : observations[i].pose;
+    tracked = pose;
+    const Eigen::Vector2d position = pose.translation().template head<2>();
+    Location at = places.locate(position, tolerance);
     nlohmann::json line = {
         {"observation", i},
         {"source", input.labels.at(i)},
@@ -734,7 +755,14 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
       LocalizeOptions options;
       options.tolerance = tolerance;
       const Localization aligned = localize(
-          places, [&maps](int id) { return maps->of(id); }, *observations[i].cloud, observations[i].pose, options);
+          places, [&maps](int id) { return maps->of(id); }, *observations[i].cloud, pose, options);
+      if (track && aligned.converged && aligned.fitness_m2 < args.locate->track_fit_m2) {
+        tracked = planar ? planarPart(aligned.pose) : aligned.pose;
+        at = places.locate(tracked.translation().template head<2>(), tolerance);
+        line["place"] = at.place ? nlohmann::json(*at.place) : nlohmann::json();
+        line["distance_m"] = at.place ? nlohmann::json(at.distance_m) : nlohmann::json();
+        ++followed;
+      }
       line["converged"] = aligned.converged;
       line["fitness_m2"] = aligned.converged ? nlohmann::json(aligned.fitness_m2) : nlohmann::json();
       if (aligned.converged) {
@@ -743,6 +771,9 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
         line["aligned_place"] = aligned.place ? nlohmann::json(*aligned.place) : nlohmann::json();
       }
     }
+    if (track) line["tracked_pose"] = poseJson(tracked);
+    inside += at.place && at.distance_m == 0;
+    near += at.place && at.distance_m > 0;
     text += (i ? ",\n  " : "\n  ") + line.dump();
   }
   text += observations.empty() ? "]}\n" : "\n ]}\n";
@@ -751,6 +782,10 @@ int locateObservations(const PartitionArgs& args, const std::vector<Observation<
     std::fprintf(stderr, "obsgroup: %zu observations: %zu in a place, %zu within %g m of one, %zu in none\n",
                  observations.size(), inside, near, tolerance, observations.size() - inside - near);
     if (maps) std::fprintf(stderr, "  %zu of %zu aligned to their place's local map\n", converged, inside + near);
+    if (track) std::fprintf(stderr, "  %zu followed their alignment (fit below %g m^2)\n", followed, args.locate->track_fit_m2);
+    if (!odometry.is_null() && odometry.at("applied").get<bool>())
+      std::fprintf(stderr, "  poses corrected by scan matching first: %d of %d steps changed\n",
+                   odometry.at("matched").get<int>(), odometry.at("steps").get<int>());
     std::fprintf(stderr, "  wrote %s\n", args.output.c_str());
   }
   return 0;
@@ -802,14 +837,15 @@ nlohmann::json correctPoses(const PartitionArgs& args, std::vector<Observation<P
 
 template <typename PointT>
 int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> observations, InputRecord input) {
-  if (args.locate) return locateObservations(args, observations, input);
+  double odometry_seconds = 0;
+  if (args.locate) return locateObservations(args, observations, input, correctPoses(args, observations, odometry_seconds));
   Warnings warn(args.quiet);
   for (const auto& w : input.warnings) warn(w);
   throwIfInterrupted(args.interrupt);
   const std::vector<std::string> sources = input.labels;
   const std::vector<double> stamps = input.stamps;
   const std::vector<int> keyframe_of = keepKeyframes(args, observations, input);
-  double odometry_seconds = 0;
+  // The keyframes' poses only: the frames between them take their keyframe's group.
   const nlohmann::json odometry = correctPoses(args, observations, odometry_seconds);
   GroupingOutcome<PointT> grouped;
   configureGrouping(args, grouped.grouping);

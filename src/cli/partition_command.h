@@ -42,6 +42,13 @@ struct LocateOptions {
   /// Align each located observation to its place's local map (PCL's ICP)
   /// and report the aligned pose, its place and the fit.
   bool align = false;
+  /// Align each observation in turn from the previous one's aligned pose
+  /// moved by the input's step, and locate it at its aligned pose: a drifted
+  /// run follows the map. Off (--no-track): each at its own pose.
+  bool track = true;
+  /// --track: an alignment is followed when its fit (mean squared distance
+  /// of the matched points) is below this, m^2.
+  double track_fit_m2 = 0.01;
 };
 
 struct PartitionArgs {
