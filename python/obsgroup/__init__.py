@@ -51,7 +51,7 @@ __version__ = "0.1.0"
 __all__ = [
     "InputError", "UsageError", "ObsgroupWarning", "Observation", "Observations", "read", "Grouping",
     "Partition", "OnlineGrouping", "Change", "LocalMap", "MetricTopologicalMap", "build_local_maps",
-    "Places", "Location", "partition",
+    "Places", "Location", "partition", "correct_odometry",
 ]
 
 ProgressCallback = Callable[[str, int, int], Any]
@@ -192,6 +192,19 @@ def read(path: Union[str, os.PathLike], *, progress: Optional[ProgressCallback] 
     out.warnings = list(messages)
     _warn(messages)
     return out
+
+
+def correct_odometry(observations: Sequence[Observation], *, mode: str = "auto",
+                     threads: int = 0) -> Tuple[List[Observation], Dict[str, Any]]:
+    """The observations at their poses corrected by scan matching, as the command corrects them
+    before grouping (``--correct-odometry``): each aligned with the one before it from the step
+    their poses give. ``mode="auto"`` keeps the poses unless the corrected map is sharper (drifted
+    odometry; exact or SLAM-corrected poses are kept), ``"on"`` always corrects, ``"off"`` never.
+    Returns the observations (the same clouds, new poses) and what was done (``applied``,
+    ``steps``, ``matched``, ...; as ``partition.json``'s ``statistics.odometry_correction``).
+    ``Grouping`` groups at the poses it is given: correct them first to get the command's groups."""
+    corrected, report = _call(_obsgroup._correct_odometry, list(observations), mode, int(threads))
+    return list(corrected), dict(report)
 
 
 # --- the batch grouping ----------------------------------------------------------------------------

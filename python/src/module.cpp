@@ -13,6 +13,7 @@
 #include <obsgroup/common/invalid_observation.h>
 #include <obsgroup/io/errors.h>
 #include <obsgroup/maps/local_map_builder.h>
+#include <obsgroup/maps/odometry_correction.h>
 #include <obsgroup/maps/topological_map.h>
 #include <obsgroup/observation_grouping.h>
 #include <obsgroup/online_grouping.h>
@@ -474,6 +475,32 @@ struct PyLocalMap {
   LocalMap<pcl::PointXYZ> map;
 };
 
+/// The observations at their poses corrected by scan matching (the same
+/// clouds, shared), and what correctOdometry() did, as a dict.
+py::tuple correctOdometryOf(const std::vector<PyObservation>& observations, const std::string& mode_name, int threads) {
+  const OdometryCorrection mode = odometryCorrectionFromString(mode_name);  // std::invalid_argument: ValueError
+  std::vector<Observation<pcl::PointXYZ>> clouds;
+  clouds.reserve(observations.size());
+  for (const auto& o : observations) clouds.push_back({o.xyz(), o.pose});
+  OdometryCorrectionParameters parameters;
+  parameters.threads = threads;
+  InterruptFlag flag{false};
+  const OdometryCorrectionReport r = runReleased([&] { return correctOdometry(clouds, mode, parameters); }, flag);
+  std::vector<PyObservation> corrected = observations;
+  for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = clouds[i].pose;
+  py::dict report;
+  report["applied"] = r.applied;
+  report["steps"] = r.steps;
+  report["matched"] = r.matched;
+  report["kept"] = r.kept;
+  report["unaligned"] = r.unaligned;
+  report["sampled"] = r.sampled;
+  report["sample_matched"] = r.sample_matched;
+  report["input_map_cells"] = r.input_cells;
+  report["corrected_map_cells"] = r.corrected_cells;
+  return py::make_tuple(corrected, report);
+}
+
 py::tuple buildLocalMaps(const std::vector<PyObservation>& observations, const PyPartition& partition,
                          const std::string& refine, double voxel, int threads, const py::object& callback) {
   const Refinement refinement = refinementFromString(refine);  // std::invalid_argument: ValueError
@@ -672,6 +699,7 @@ PYBIND11_MODULE(_obsgroup, m) {
       .def_property_readonly("filtered", [](const PyLocalMap& l) { return l.map.filtered; },
                              "False when the map was too large for the voxel filter and kept whole.");
   m.def("_build_local_maps", &buildLocalMaps);
+  m.def("_correct_odometry", &correctOdometryOf);
 
   py::class_<PlaceMap>(m, "_PlaceMap")
       .def("locate", &locate, py::arg("x"), py::arg("y"), py::arg("tolerance"));

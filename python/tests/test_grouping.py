@@ -38,13 +38,32 @@ def test_the_paper_preset_and_options_reach_the_grouping(data, tmp_path):
     assert grouping.parameters["model"] == "points"
     assert grouping.parameters["ncut_threshold"] == 1.0
     assert grouping.compute().groups == expected["groups"]
-    # The module groups at the poses given: the command's scan matching of
-    # this log's raw odometry is turned off to compare them.
-    expected = run_command(log, tmp_path / "threshold", "--ncut-threshold", "0.9", "--cell", "0.25",
+    # The command corrects this log's raw odometry before grouping;
+    # correct_odometry does the same, and Grouping groups at the poses given.
+    expected = run_command(log, tmp_path / "threshold", "--ncut-threshold", "0.9", "--cell", "0.25")
+    assert expected["statistics"]["odometry_correction"]["applied"]
+    corrected, report = obsgroup.correct_odometry(obsgroup.read(log))
+    assert report["applied"] and report["matched"] == expected["statistics"]["odometry_correction"]["matched"]
+    grouping = obsgroup.Grouping(ncut_threshold=0.9, cell=0.25, threads=1)
+    grouping.extend(corrected)
+    assert grouping.compute().groups == expected["groups"]
+    expected = run_command(log, tmp_path / "as_given", "--ncut-threshold", "0.9", "--cell", "0.25",
                            "--correct-odometry", "off")
     grouping = obsgroup.Grouping(ncut_threshold=0.9, cell=0.25, threads=1)
     grouping.extend(obsgroup.read(log))
     assert grouping.compute().groups == expected["groups"]
+
+
+def test_correct_odometry_keeps_exact_poses_and_the_clouds(data):
+    scans = obsgroup.read(data / "office_2d" / "office.clf")
+    corrected, report = obsgroup.correct_odometry(scans)
+    assert not report["applied"] and report["sampled"] > 0 and report["sample_matched"] == 0
+    for a, b in zip(scans, corrected):
+        assert np.array_equal(a.pose, b.pose) and np.array_equal(a.points, b.points)
+    corrected, report = obsgroup.correct_odometry(scans, mode="off")
+    assert report["steps"] == 0
+    with pytest.raises(ValueError):
+        obsgroup.correct_odometry(scans, mode="sometimes")
 
 
 def test_the_defaults_are_the_commands():
