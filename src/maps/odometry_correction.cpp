@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <tuple>
 #include <unordered_set>
 
 namespace obsgroup {
@@ -169,9 +170,12 @@ OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std:
     // Poses that scan matching leaves as they are on a sample of the steps
     // (exact poses: none changes) are not matched at all: a long log of
     // consistent poses pays for the sample only.
+    // A first sample of a quarter of that size, where no step changes, is
+    // enough: a depth camera's step costs about 10 ms.
     const std::size_t steps = poses.size() - 1;
-    const std::size_t stride = std::max<std::size_t>(1, steps / std::max(1, parameters.sample_steps));
-    const auto [matched, sampled] = matcher.matchSample(stride, parameters.threads);
+    const auto stride = [steps](int count) { return std::max<std::size_t>(1, steps / std::size_t(std::max(1, count))); };
+    auto [matched, sampled] = matcher.matchSample(stride(parameters.sample_steps / 4), parameters.threads);
+    if (matched > 0) std::tie(matched, sampled) = matcher.matchSample(stride(parameters.sample_steps), parameters.threads);
     report.sampled = sampled;
     report.sample_matched = matched;
     if (double(matched) < parameters.min_sample_share * double(sampled)) {

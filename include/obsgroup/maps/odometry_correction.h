@@ -62,7 +62,8 @@ struct OdometryCorrectionParameters {
   /// floor plans 0.37-0.72, simulated depth cameras 0.69-0.76, SLAM-corrected
   /// real logs 1.06-1.75 (docs/method.md).
   double max_cell_ratio = 0.9;
-  /// Auto: about this many steps, evenly spread, are matched first...
+  /// Auto: about this many steps, evenly spread, are matched first (a
+  /// quarter of them before, the rest only when one of those changed)...
   int sample_steps = 100;
   /// ...and the rest only when at least this share of them changed.
   double min_sample_share = 0.1;
