@@ -41,7 +41,6 @@ double consistencyAt(const PreparedMember& source, const PreparedMember& target,
 
 enum class StepOutcome { Matched, Kept, Unaligned };
 
-
 /// The step from the previous observation to `current`: the matched one
 /// when it aligns and is better by min_gain, else the input's.
 StepOutcome correctStep(const PreparedMember& current, const PreparedMember& previous, const Eigen::Isometry3d& input_step,
@@ -169,9 +168,9 @@ OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std:
   if (mode == OdometryCorrection::Auto) {
     // Poses that scan matching leaves as they are on a sample of the steps
     // (exact poses: none changes) are not matched at all: a long log of
-    // consistent poses pays for the sample only.
-    // A first sample of a quarter of that size, where no step changes, is
-    // enough: a depth camera's step costs about 10 ms.
+    // consistent poses pays for the sample only. A first sample of a quarter
+    // of the size decides when none of its steps changes: a depth camera's
+    // step costs about 10 ms.
     const std::size_t steps = poses.size() - 1;
     const auto stride = [steps](int count) { return std::max<std::size_t>(1, steps / std::size_t(std::max(1, count))); };
     auto [matched, sampled] = matcher.matchSample(stride(parameters.sample_steps / 4), parameters.threads);
