@@ -25,7 +25,6 @@
 #include <obsgroup/io/pose_file.h>
 #include <obsgroup/places/localize.h>
 #include <obsgroup/partition/keyframes.h>
-
 #include <obsgroup/places/place_map.h>
 
 #include <omp.h>
@@ -705,7 +704,6 @@ nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
   return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"qw", q.w()}, {"qx", q.x()}, {"qy", q.y()}, {"qz", q.z()}};
 }
 
-/// `obsgroup locate`: each observation's place in the places of a run.
 /// True for a ground robot's pose: in the plane z = 0, turned about z only.
 bool isPlanarPose(const Eigen::Isometry3d& pose) {
   const Eigen::Matrix3d& R = pose.linear();
@@ -718,6 +716,7 @@ Eigen::Isometry3d planarPart(const Eigen::Isometry3d& pose) {
   return pose2D(pose.translation().x(), pose.translation().y(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)));
 }
 
+/// `obsgroup locate`: each observation's place in the places of a run.
 template <typename PointT>
 int locateObservations(const PartitionArgs& args, const std::vector<Observation<PointT>>& observations,
                        const InputRecord& input, const nlohmann::json& odometry) {
