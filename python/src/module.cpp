@@ -475,13 +475,19 @@ struct PyLocalMap {
   LocalMap<pcl::PointXYZ> map;
 };
 
+/// The observations as PointXYZ clouds (shared when they are) at their poses.
+std::vector<Observation<pcl::PointXYZ>> xyzObservations(const std::vector<PyObservation>& observations) {
+  std::vector<Observation<pcl::PointXYZ>> clouds;
+  clouds.reserve(observations.size());
+  for (const auto& o : observations) clouds.push_back({o.xyz(), o.pose});
+  return clouds;
+}
+
 /// The observations at their poses corrected by scan matching (the same
 /// clouds, shared), and what correctOdometry() did, as a dict.
 py::tuple correctOdometryOf(const std::vector<PyObservation>& observations, const std::string& mode_name, int threads) {
   const OdometryCorrection mode = odometryCorrectionFromString(mode_name);  // std::invalid_argument: ValueError
-  std::vector<Observation<pcl::PointXYZ>> clouds;
-  clouds.reserve(observations.size());
-  for (const auto& o : observations) clouds.push_back({o.xyz(), o.pose});
+  std::vector<Observation<pcl::PointXYZ>> clouds = xyzObservations(observations);
   OdometryCorrectionParameters parameters;
   parameters.threads = threads;
   InterruptFlag flag{false};
@@ -507,9 +513,7 @@ py::tuple buildLocalMaps(const std::vector<PyObservation>& observations, const P
   if (partition.partition.group_of.size() != observations.size())
     throw py::value_error("the partition groups " + std::to_string(partition.partition.group_of.size()) +
                           " observations, not the " + std::to_string(observations.size()) + " given");
-  std::vector<Observation<pcl::PointXYZ>> clouds;
-  clouds.reserve(observations.size());
-  for (const auto& o : observations) clouds.push_back({o.xyz(), o.pose});
+  std::vector<Observation<pcl::PointXYZ>> clouds = xyzObservations(observations);
   LocalMapBuilder<pcl::PointXYZ> builder;
   builder.setRefinement(refinement);
   builder.setVoxelLeafSize(voxel);
