@@ -100,7 +100,7 @@ struct Dataset {
   PoseSource poses = PoseSource::Exact;
   std::vector<Observation<pcl::PointXYZ>> observations;
   /// The same scans at the poses the command groups at: corrected by scan
-  /// matching when that draws a sharper map (OdometryCorrection::Auto).
+  /// matching when that draws a more consistent map (OdometryCorrection::Auto).
   std::vector<Observation<pcl::PointXYZ>> corrected;
   double corrected_rms = 0.0;  ///< of `corrected`, from the true poses, metres
   bool correction_applied = false;
@@ -284,7 +284,7 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
 }
 
 /// The observations configuration `c` groups: at the poses given, or at the
-/// command's (corrected when that is sharper).
+/// command's (corrected when that is more consistent).
 template <typename D>
 const std::vector<Observation<pcl::PointXYZ>>& posed(const D& d, const Configuration& c) {
   return c.correct_odometry == OdometryCorrection::Off ? d.observations : d.corrected;
@@ -695,7 +695,7 @@ const char* kUsage =
     "  --band-low M  --band-high M  --door-width M  --door-depth M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
     "  --mutual-neighbours N  --mutual-neighbours-share X\n"
     "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
-    "  --correct-odometry auto|off (auto: at the poses the command groups at, scan-matched when sharper)\n"
+    "  --correct-odometry auto|off (auto: at the poses the command groups at, scan-matched when more consistent)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
     "selection (defaults: all):\n"
     "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth[,lidar]  --poses exact,drift\n"

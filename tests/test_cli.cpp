@@ -1891,6 +1891,8 @@ TEST_F(Cli, DriftedOdometryIsCorrectedBeforeGroupingAndLocating) {
   const nlohmann::json& correction = partition.at("statistics").at("odometry_correction");
   EXPECT_TRUE(correction.at("applied").get<bool>());
   EXPECT_LT(correction.at("corrected_map_cells").get<double>(), 0.5 * correction.at("input_map_cells").get<double>());
+  EXPECT_LT(correction.at("corrected_blocked_share").get<double>(),
+            0.8 * correction.at("input_blocked_share").get<double>());
   EXPECT_EQ(partition.at("parameters").at("correct_odometry"), "auto");
   std::map<int, int> place_of;
   for (std::size_t g = 0; g < partition.at("groups").size(); ++g)

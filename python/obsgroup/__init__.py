@@ -198,7 +198,7 @@ def correct_odometry(observations: Sequence[Observation], *, mode: str = "auto",
                      threads: int = 0) -> Tuple[List[Observation], Dict[str, Any]]:
     """The observations at their poses corrected by scan matching, as the command corrects them
     before grouping (``--correct-odometry``): each aligned with the one before it from the step
-    their poses give. ``mode="auto"`` keeps the poses unless the corrected map is sharper (drifted
+    their poses give. ``mode="auto"`` keeps the poses unless the corrected map is more consistent (drifted
     odometry; exact or SLAM-corrected poses are kept), ``"on"`` always corrects, ``"off"`` never.
     Returns the observations (the same clouds, new poses) and what was done (``applied``,
     ``steps``, ``matched``, ...; as ``partition.json``'s ``statistics.odometry_correction``).

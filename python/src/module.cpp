@@ -504,6 +504,8 @@ py::tuple correctOdometryOf(const std::vector<PyObservation>& observations, cons
   report["sample_matched"] = r.sample_matched;
   report["input_map_cells"] = r.input_cells;
   report["corrected_map_cells"] = r.corrected_cells;
+  report["input_blocked_share"] = r.input_blocked_share;
+  report["corrected_blocked_share"] = r.corrected_blocked_share;
   return py::make_tuple(corrected, report);
 }
 

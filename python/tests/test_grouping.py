@@ -66,6 +66,14 @@ def test_correct_odometry_keeps_exact_poses_and_the_clouds(data):
         obsgroup.correct_odometry(scans, mode="sometimes")
 
 
+def test_correct_odometry_reports_the_beams_through_walls(data):
+    # sena_odometry's poses are raw odometry: fewer beams cross a wall once corrected
+    scans = obsgroup.read(data / "real" / "sena_odometry" / "sena_odometry.clf")
+    corrected, report = obsgroup.correct_odometry(scans)
+    assert report["applied"]
+    assert 0 < report["corrected_blocked_share"] < 0.8 * report["input_blocked_share"] <= 0.8
+
+
 def test_the_defaults_are_the_commands():
     parameters = obsgroup.Grouping().parameters
     assert parameters["model"] == "visibility"

@@ -281,7 +281,7 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
 void addOdometryCorrectionOption(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--correct-odometry", args.correct_odometry,
                      "scan-match each observation to the one before it and group at the corrected poses: auto (when "
-                     "the corrected map is sharper: drifted odometry), on or off (default: " +
+                     "the corrected map is more consistent: drifted odometry), on or off (default: " +
                          toString(args.correct_odometry) + ")")
       ->transform(oneOf(kOdometryCorrectionNames))
       ->option_text(choices(kOdometryCorrectionNames))

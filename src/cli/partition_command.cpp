@@ -591,9 +591,17 @@ void printOdometryCorrection(const io::RunRecord& run) {
   const auto& s = run.statistics;
   if (!s.contains("odometry_correction") || !s.at("odometry_correction").at("applied").get<bool>()) return;
   const auto& c = s.at("odometry_correction");
-  std::fprintf(stderr, "  poses corrected by scan matching: %d of %d steps changed (map %zu cells, %zu at the input poses)\n",
-               c.at("matched").get<int>(), c.at("steps").get<int>(), c.at("corrected_map_cells").get<std::size_t>(),
-               c.at("input_map_cells").get<std::size_t>());
+  const double blocked = c.at("corrected_blocked_share").get<double>();
+  if (blocked > 0 || c.at("input_blocked_share").get<double>() > 0)
+    std::fprintf(stderr,
+                 "  poses corrected by scan matching: %d of %d steps changed (%.0f%% of beams through a wall, %.0f%% at "
+                 "the input poses)\n",
+                 c.at("matched").get<int>(), c.at("steps").get<int>(), 100 * blocked,
+                 100 * c.at("input_blocked_share").get<double>());
+  else
+    std::fprintf(stderr, "  poses corrected by scan matching: %d of %d steps changed (map %zu cells, %zu at the input poses)\n",
+                 c.at("matched").get<int>(), c.at("steps").get<int>(), c.at("corrected_map_cells").get<std::size_t>(),
+                 c.at("input_map_cells").get<std::size_t>());
 }
 
 void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
@@ -831,7 +839,9 @@ nlohmann::json correctPoses(const PartitionArgs& args, std::vector<Observation<P
           {"sampled", r.sampled},
           {"sample_matched", r.sample_matched},
           {"input_map_cells", r.input_cells},
-          {"corrected_map_cells", r.corrected_cells}};
+          {"corrected_map_cells", r.corrected_cells},
+          {"input_blocked_share", r.input_blocked_share},
+          {"corrected_blocked_share", r.corrected_blocked_share}};
 }
 
 template <typename PointT>

@@ -7,10 +7,13 @@
 #include "obsgroup/common/parallel_for.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <tuple>
+#include <unordered_map>
 #include <unordered_set>
 
 namespace obsgroup {
@@ -159,6 +162,101 @@ std::size_t occupiedCells(const PointsOfObservation& points, const std::vector<E
   return cells.size();
 }
 
+namespace {
+
+/// The occupied cells of a plane map, as bitmaps of 64 x 64 cells found
+/// through a hash of their tiles: a drifted log's map may span kilometres
+/// in both directions, which a single bitmap could not.
+class PlaneOccupancy {
+ public:
+  explicit PlaneOccupancy(double cell) : cell_(cell) {}
+
+  void add(const Eigen::Vector2d& p) {
+    const auto [x, y] = cellOf(p);
+    std::uint64_t& word = tile(tileKey(x, y))[std::size_t(y & 63)];
+    const std::uint64_t bit = std::uint64_t(1) << (x & 63);
+    count_ += (word & bit) == 0;
+    word |= bit;
+  }
+  std::size_t count() const { return count_; }
+
+  /// Whether the beam from `from` to `to` crosses an occupied cell between
+  /// `start` metres from `from` and `end_margin` short of `to`, at most
+  /// `reach` metres out. False for beams too short to follow.
+  bool blocks(const Eigen::Vector2d& from, const Eigen::Vector2d& to, double start, double end_margin,
+              double reach) const {
+    const Eigen::Vector2d d = to - from;
+    const double length = d.norm();
+    const double end = std::min(length - end_margin, reach);
+    if (!(end > start)) return false;
+    const Eigen::Vector2d u = d / length;
+    const double step = cell_ / 2;  // every cell the beam crosses by more than a corner
+    std::int64_t last_x = std::numeric_limits<std::int64_t>::min(), last_y = last_x;
+    for (double t = start; t <= end; t += step) {
+      const auto [x, y] = cellOf(from + t * u);
+      if (x == last_x && y == last_y) continue;
+      last_x = x;
+      last_y = y;
+      if (occupied(x, y)) return true;
+    }
+    return false;
+  }
+
+ private:
+  using Tile = std::array<std::uint64_t, 64>;
+  std::pair<std::int64_t, std::int64_t> cellOf(const Eigen::Vector2d& p) const {
+    return {std::int64_t(std::floor(p.x() / cell_)), std::int64_t(std::floor(p.y() / cell_))};
+  }
+  static std::uint64_t tileKey(std::int64_t x, std::int64_t y) {
+    return (std::uint64_t(x >> 6) << 32) ^ (std::uint64_t(y >> 6) & 0xffffffffu);
+  }
+  Tile& tile(std::uint64_t key) {
+    auto [it, added] = index_.try_emplace(key, tiles_.size());
+    if (added) tiles_.emplace_back();
+    return tiles_[it->second];
+  }
+  bool occupied(std::int64_t x, std::int64_t y) const {
+    const auto it = index_.find(tileKey(x, y));
+    return it != index_.end() && (tiles_[it->second][std::size_t(y & 63)] >> (x & 63) & 1);
+  }
+
+  double cell_;
+  std::unordered_map<std::uint64_t, std::size_t> index_;
+  std::vector<Tile> tiles_;
+  std::size_t count_ = 0;
+};
+
+}  // namespace
+
+MapConsistency mapConsistency(const PointsOfObservation& points, const std::vector<Eigen::Isometry3d>& poses,
+                              double cell, int threads) {
+  // Beams start off the sensor (a drifted pose may stand in a wall's cell, as
+  // the visibility model's clearance allows) and end short of their point
+  // (its own wall, give or take a cell); past 8 m they say little indoors.
+  constexpr double kStart = 0.3, kEndMargin = 0.5, kReach = 8.0;
+  std::vector<std::vector<Eigen::Vector2d>> world(poses.size());
+  PlaneOccupancy occupancy(cell);
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    for (const Eigen::Vector3f& p : points(i)) occupancy.add((poses[i] * p.cast<double>()).head<2>());
+  MapConsistency out;
+  out.occupied_cells = occupancy.count();
+  std::vector<std::size_t> beams(poses.size(), 0), blocked(poses.size(), 0);
+  parallelFor(poses.size(), threads, 16, [&](std::size_t i) {
+    const Eigen::Vector2d from = poses[i].translation().head<2>();
+    for (const Eigen::Vector3f& p : points(i)) {
+      const Eigen::Vector2d to = (poses[i] * p.cast<double>()).head<2>();
+      if (!((to - from).norm() - kEndMargin > kStart)) continue;
+      ++beams[i];
+      blocked[i] += occupancy.blocks(from, to, kStart, kEndMargin, kReach);
+    }
+  });
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    out.beams += beams[i];
+    out.blocked_beams += blocked[i];
+  }
+  return out;
+}
+
 OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std::vector<Eigen::Isometry3d>& poses,
                                          bool planar, OdometryCorrection mode,
                                          const OdometryCorrectionParameters& parameters) {
@@ -184,10 +282,21 @@ OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std:
   }
   matcher.matchAll(parameters.threads);
   std::vector<Eigen::Isometry3d> corrected = matcher.chained(report);
-  report.input_cells = occupiedCells(points, poses, parameters.map_cell, planar);
-  report.corrected_cells = occupiedCells(points, corrected, parameters.map_cell, planar);
-  report.applied = mode == OdometryCorrection::On ||
-                   double(report.corrected_cells) <= parameters.max_cell_ratio * double(report.input_cells);
+  if (planar) {
+    const MapConsistency input = mapConsistency(points, poses, parameters.map_cell, parameters.threads);
+    const MapConsistency matched = mapConsistency(points, corrected, parameters.map_cell, parameters.threads);
+    report.input_cells = input.occupied_cells;
+    report.corrected_cells = matched.occupied_cells;
+    report.input_blocked_share = input.blockedShare();
+    report.corrected_blocked_share = matched.blockedShare();
+    report.applied = mode == OdometryCorrection::On ||
+                     report.corrected_blocked_share <= parameters.max_conflict_ratio * report.input_blocked_share;
+  } else {
+    report.input_cells = occupiedCells(points, poses, parameters.map_cell, planar);
+    report.corrected_cells = occupiedCells(points, corrected, parameters.map_cell, planar);
+    report.applied = mode == OdometryCorrection::On ||
+                     double(report.corrected_cells) <= parameters.max_cell_ratio * double(report.input_cells);
+  }
   if (report.applied) poses = std::move(corrected);
   return report;
 }
