@@ -485,6 +485,30 @@ TEST(OdometryCorrection, DepthCloudsAreCorrectedInSixDegreesOfFreedom) {
   EXPECT_LT(sim::rmsPositionError(posesOf(route.observations), route.truth), 0.5 * before) << before << " m before";
 }
 
+TEST(OdometryCorrection, ReportsItsProgressAndStopsWhenAsked) {
+  OfficeRoute route = officeRoute(sim::Sensor::Laser360);
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(route.truth, 7);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  OdometryCorrectionParameters parameters;
+  std::vector<std::size_t> done;
+  std::size_t total = 0;
+  parameters.progress = [&](std::size_t d, std::size_t t) {
+    done.push_back(d);
+    total = t;
+  };
+  auto observations = route.observations;
+  correctOdometry(observations, OdometryCorrection::On, parameters);
+  EXPECT_EQ(total, route.observations.size() - 1);
+  ASSERT_EQ(done.size(), total);
+  for (std::size_t k = 0; k < done.size(); ++k) EXPECT_EQ(done[k], k + 1);
+  InterruptFlag stop{true};
+  parameters.interrupt = &stop;
+  observations = route.observations;
+  EXPECT_THROW(correctOdometry(observations, OdometryCorrection::On, parameters), Interrupted);
+  for (std::size_t k = 0; k < drifted.size(); ++k)  // the poses as they were
+    EXPECT_TRUE(observations[k].pose.matrix() == drifted[k].matrix()) << k;
+}
+
 TEST(OdometryCorrection, ModesAreNamedAsTheCommandLineSpellsThem) {
   EXPECT_EQ(odometryCorrectionFromString("auto"), OdometryCorrection::Auto);
   EXPECT_EQ(toString(OdometryCorrection::Off), "off");

@@ -491,6 +491,7 @@ py::tuple correctOdometryOf(const std::vector<PyObservation>& observations, cons
   OdometryCorrectionParameters parameters;
   parameters.threads = threads;
   InterruptFlag flag{false};
+  parameters.interrupt = &flag;  // Ctrl-C stops a long log's matching between steps
   const OdometryCorrectionReport r = runReleased([&] { return correctOdometry(clouds, mode, parameters); }, flag);
   std::vector<PyObservation> corrected = observations;
   for (std::size_t i = 0; i < corrected.size(); ++i) corrected[i].pose = clouds[i].pose;

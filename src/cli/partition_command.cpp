@@ -828,7 +828,11 @@ nlohmann::json correctPoses(const PartitionArgs& args, std::vector<Observation<P
   const Clock::time_point start = Clock::now();
   OdometryCorrectionParameters parameters;
   parameters.threads = args.method.threads;
+  parameters.interrupt = args.interrupt;
+  ProgressBar bar("scan matching", !args.quiet, args.progress);
+  parameters.progress = [&bar](std::size_t done, std::size_t total) { bar(done, total); };
   const OdometryCorrectionReport r = correctOdometry(observations, args.correct_odometry, parameters);
+  bar.finish();
   throwIfInterrupted(args.interrupt);
   seconds = secondsSince(start);
   return {{"applied", r.applied},

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <tuple>
 #include <unordered_map>
 #include <unordered_set>
@@ -83,12 +84,14 @@ class StepMatcher {
 
   /// Matches the steps into observations first, first + 1, ..., last - 1,
   /// each observation prepared once.
-  void matchRun(std::size_t first, std::size_t last) {
+  void matchRun(std::size_t first, std::size_t last, const std::function<void()>& step_done = {}) {
     std::unique_ptr<PreparedMember> previous = prepare(points_(first - 1), voxel_, planar_);
     for (std::size_t i = first; i < last; ++i) {
+      throwIfInterrupted(parameters_.interrupt);
       std::unique_ptr<PreparedMember> current = prepare(points_(i), voxel_, planar_);
       outcomes_[i] = correctStep(*current, *previous, poses_[i - 1].inverse() * poses_[i], freedom_, parameters_, steps_[i]);
       previous = std::move(current);
+      if (step_done) step_done();
     }
   }
 
@@ -96,7 +99,15 @@ class StepMatcher {
   void matchAll(int threads) {
     const std::size_t n = poses_.size() - 1;
     const std::size_t runs = std::min<std::size_t>(n, 64);
-    parallelFor(runs, threads, [&](std::size_t r) { matchRun(1 + n * r / runs, 1 + n * (r + 1) / runs); });
+    std::mutex reporting;
+    std::size_t done = 0;
+    const std::function<void()> step_done = [&] {
+      const std::lock_guard<std::mutex> lock(reporting);
+      parameters_.progress(++done, n);
+    };
+    parallelFor(runs, threads, [&](std::size_t r) {
+      matchRun(1 + n * r / runs, 1 + n * (r + 1) / runs, parameters_.progress ? step_done : std::function<void()>());
+    });
   }
 
   /// Every `stride`-th step only; returns how many it matched of how many.

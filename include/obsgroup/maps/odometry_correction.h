@@ -15,6 +15,7 @@
 #include "obsgroup/cloud/finite_points.h"
 #include "obsgroup/cloud/observation.h"
 #include "obsgroup/common/enum_names.h"
+#include "obsgroup/common/interrupt.h"
 #include "obsgroup/maps/refinement.h"
 
 #include <Eigen/Geometry>
@@ -76,6 +77,13 @@ struct OdometryCorrectionParameters {
   /// ...and the rest only when at least this share of them changed.
   double min_sample_share = 0.1;
   int threads = 0;  ///< 0: all cores; the result does not depend on it
+  /// Polled between steps: when set, correctOdometry throws Interrupted (a
+  /// drifted log matches every step, about a millisecond each for 2D scans).
+  const InterruptFlag* interrupt = nullptr;
+  /// Called with the steps matched so far (never fewer than the call
+  /// before) and the steps to match, one thread at a time; the sample of
+  /// `Auto` is not reported.
+  std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 /// What the correction did.
