@@ -2,6 +2,10 @@
 // rooms on both sides) whose local density stays bounded however long it is.
 //
 //   make_scaling_input 2d N FILE.clf   N scans of 360 beams (360 degrees, 20 m) as a CARMEN log
+//   make_scaling_input 2d-biased N FILE.clf
+//                                      the same scans at the poses of biased odometry: each step
+//                                      2% too long and turned 1 degree per metre too far (a 2 km
+//                                      route winds round about five times: docs/method.md)
 //   make_scaling_input 3d N FOLDER     N depth-camera clouds of 160 x 120 points as PCD files
 //   make_scaling_input depth N FOLDER  N 640 x 480 depth images (Redwood layout: depth/*.png,
 //                                      trajectory.log) of a hand-held camera circling one
@@ -13,11 +17,13 @@
 
 #include "floor_plan.h"
 #include "png_writer.h"
+#include "scenarios.h"
 #include "to_cloud.h"
 
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -31,10 +37,20 @@ namespace {
 
 constexpr double kBuildingPerScan = 0.2;  // metres of building per scan
 
-int write2D(int n, const std::string& path) {
+int write2D(int n, const std::string& path, bool biased) {
   const double length = std::max(16.0, n * kBuildingPerScan);
   const FloorPlan plan = longBuilding(length);
   const auto route = longBuildingRoute(length, n);
+  // The poses the log gives: the truth, or biased odometry's.
+  std::vector<Pose2D> logged = route;
+  if (biased) {
+    std::vector<Eigen::Isometry3d> truth;
+    for (const Pose2D& p : route) truth.push_back(toIsometry(p));
+    const std::vector<Eigen::Isometry3d> odometry = biasedDrift(truth);
+    for (std::size_t k = 0; k < route.size(); ++k)
+      logged[k] = {odometry[k].translation().x(), odometry[k].translation().y(),
+                   std::atan2(odometry[k].linear()(1, 0), odometry[k].linear()(0, 0))};
+  }
   LaserModel laser;
   laser.beams = 360;
   laser.field_of_view = 2 * 3.14159265358979323846 * 359.0 / 360.0;  // 1 degree apart, no beam twice
@@ -54,8 +70,9 @@ int write2D(int n, const std::string& path) {
       std::snprintf(buffer, sizeof buffer, " %.3f", r);
       line += buffer;
     }
-    std::snprintf(buffer, sizeof buffer, " 0 %.6f %.6f %.6f %.6f %.6f %.6f 0 0 0 0 0 %.3f sim %.3f\n", p.x, p.y, p.yaw,
-                  p.x, p.y, p.yaw, k * 0.1, k * 0.1);
+    const Pose2D& q = logged[k];
+    std::snprintf(buffer, sizeof buffer, " 0 %.6f %.6f %.6f %.6f %.6f %.6f 0 0 0 0 0 %.3f sim %.3f\n", q.x, q.y, q.yaw,
+                  q.x, q.y, q.yaw, k * 0.1, k * 0.1);
     line += buffer;
   }
   std::ofstream out(path);
@@ -203,8 +220,9 @@ int writeLidar(int n, const std::string& folder) {
 
 int main(int argc, char** argv) {
   const std::string kind = argc == 4 ? argv[1] : "";
-  if ((kind != "2d" && kind != "3d" && kind != "depth" && kind != "lidar") || std::atoi(argv[2]) < 1) {
-    std::cerr << "usage: " << argv[0] << " 2d|3d|depth|lidar N OUTPUT\n";
+  if ((kind != "2d" && kind != "2d-biased" && kind != "3d" && kind != "depth" && kind != "lidar") ||
+      std::atoi(argv[2]) < 1) {
+    std::cerr << "usage: " << argv[0] << " 2d|2d-biased|3d|depth|lidar N OUTPUT\n";
     return 2;
   }
   if (std::filesystem::exists(argv[3])) {
@@ -214,5 +232,6 @@ int main(int argc, char** argv) {
   const int n = std::atoi(argv[2]);
   if (kind == "depth") return writeDepth(n, argv[3]);
   if (kind == "lidar") return writeLidar(n, argv[3]);
-  return kind == "2d" ? write2D(n, argv[3]) : write3D(n, argv[3]);
+  if (kind == "2d" || kind == "2d-biased") return write2D(n, argv[3], kind == "2d-biased");
+  return write3D(n, argv[3]);
 }

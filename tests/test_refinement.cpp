@@ -401,13 +401,8 @@ TEST(OdometryCorrection, BiasedOdometryOfALongRouteIsCorrected) {
     observations.push_back({sim::scanCloud<pcl::PointXYZ>(plan, route[k], sim::laser360(), k), truth.back()});
   }
   // Each step 2% too long and turned 3 degrees per metre too far.
-  for (std::size_t k = 1; k < truth.size(); ++k) {
-    Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
-    const double metres = step.translation().head<2>().norm();
-    step.translation() *= 1.02;
-    step.rotate(Eigen::AngleAxisd(3.0 * M_PI / 180.0 * metres, Eigen::Vector3d::UnitZ()));
-    observations[k].pose = observations[k - 1].pose * step;
-  }
+  const std::vector<Eigen::Isometry3d> biased = sim::biasedDrift(truth, 1.02, 3.0);
+  for (std::size_t k = 0; k < truth.size(); ++k) observations[k].pose = biased[k];
   const double before = sim::rmsPositionError(posesOf(observations), truth);
   ASSERT_GT(before, 10.0);
   const OdometryCorrectionReport report = correctOdometry(observations, OdometryCorrection::Auto);

@@ -188,6 +188,20 @@ std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth
   return out;
 }
 
+std::vector<Eigen::Isometry3d> biasedDrift(const std::vector<Eigen::Isometry3d>& truth, double scale,
+                                           double degrees_per_metre) {
+  if (truth.empty()) return {};
+  std::vector<Eigen::Isometry3d> out{truth.front()};
+  for (std::size_t k = 1; k < truth.size(); ++k) {
+    Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
+    const double length = step.translation().head<2>().norm();
+    step.translation() *= scale;
+    step.rotate(Eigen::AngleAxisd(kPi / 180.0 * degrees_per_metre * length, Eigen::Vector3d::UnitZ()));
+    out.push_back(out.back() * step);
+  }
+  return out;
+}
+
 double rmsPositionError(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b) {
   const std::size_t n = std::min(a.size(), b.size());
   if (n == 0) return 0.0;

@@ -74,6 +74,13 @@ Eigen::Isometry3d toIsometry(const Pose2D& pose, double z = 0.0);
 /// of evaluate_local_maps). The first pose is kept; deterministic for a seed.
 std::vector<Eigen::Isometry3d> drift(const std::vector<Eigen::Isometry3d>& truth, std::uint64_t seed);
 
+/// Biased odometry, as a miscalibrated wheel radius and track width give:
+/// each step `scale` times as long as it was, and turned `degrees_per_metre`
+/// further to the left for each metre of it. A long route curls up into
+/// turns that fall on each other. The first pose is kept.
+std::vector<Eigen::Isometry3d> biasedDrift(const std::vector<Eigen::Isometry3d>& truth, double scale = 1.02,
+                                           double degrees_per_metre = 1.0);
+
 /// How well groups match rooms, as a user checks a map against a floor
 /// plan's rooms (corridor observations may join any room's group):
 /// a room is *found* when at least 90% of its observations are in one group
