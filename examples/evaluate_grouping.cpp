@@ -83,14 +83,19 @@ std::string format(const char* pattern, ...) {
   return buffer;
 }
 
-enum class PoseSource { Exact, Drift };
+/// Exact poses, odometry-like random drift (sim::drift), or biased odometry
+/// (sim::biasedDrift: each step 2% long and turned 1 degree per metre).
+enum class PoseSource { Exact, Drift, Bias };
 
-std::string toString(PoseSource poses) { return poses == PoseSource::Exact ? "exact" : "drift"; }
+std::string toString(PoseSource poses) {
+  return poses == PoseSource::Exact ? "exact" : poses == PoseSource::Drift ? "drift" : "bias";
+}
 
 PoseSource poseSourceFromString(const std::string& name) {
   if (name == "exact") return PoseSource::Exact;
   if (name == "drift") return PoseSource::Drift;
-  throw std::invalid_argument("unknown poses '" + name + "' (exact or drift)");
+  if (name == "bias") return PoseSource::Bias;
+  throw std::invalid_argument("unknown poses '" + name + "' (exact, drift or bias)");
 }
 
 /// One building scanned by one sensor, seen through exact or drifted poses.
@@ -114,7 +119,8 @@ struct Dataset {
 
   std::string name() const { return building + " " + sim::toString(sensor) + " " + toString(poses); }
   std::string heading() const {
-    return title + "; " + sim::describe(sensor) + ", " + (poses == PoseSource::Exact ? "exact" : "drifted") + " poses";
+    return title + "; " + sim::describe(sensor) + ", " +
+           (poses == PoseSource::Exact ? "exact poses" : poses == PoseSource::Drift ? "drifted poses" : "biased odometry");
   }
 };
 
@@ -163,6 +169,7 @@ std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, con
         truth.push_back(sim::toIsometry(pose, height));
       }
       const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
+      const std::vector<Eigen::Isometry3d> biased = sim::biasedDrift(truth);
       for (PoseSource source : pose_sources) {
         Dataset d;
         d.building = key;
@@ -173,7 +180,8 @@ std::vector<Dataset> makeDatasets(const std::vector<std::string>& buildings, con
         d.rooms = static_cast<int>(rooms_visited.size());
         d.cramped_poses = cramped;
         d.mean_points = clouds.empty() ? 0.0 : double(points) / double(clouds.size());
-        const std::vector<Eigen::Isometry3d>& seen = source == PoseSource::Exact ? truth : drifted;
+        const std::vector<Eigen::Isometry3d>& seen =
+            source == PoseSource::Exact ? truth : source == PoseSource::Drift ? drifted : biased;
         d.drift_rms = sim::rmsPositionError(seen, truth);
         for (std::size_t k = 0; k < clouds.size(); ++k) d.observations.push_back({clouds[k], seen[k]});
         d.corrected = d.observations;
@@ -365,9 +373,13 @@ int evaluateOneConfiguration(const std::vector<Dataset>& datasets, const Configu
     if (!r.error.empty())
       std::cout << format("%-24s error: %s\n", d.name().c_str(), errorText(r.error).c_str());
     else
-      std::cout << format("%-24s %4zu scans  drift %4.2f m  groups %4d (size %5.1f)  ARI %6.3f  rooms whole %2d/%-2d"
+      std::cout << format("%-24s %4zu scans  drift %4.2f m%s  groups %4d (size %5.1f)  ARI %6.3f  rooms whole %2d/%-2d"
                           "  found %2d  pure %2d  %6.2f s%s\n",
-                          d.name().c_str(), d.observations.size(), d.drift_rms, r.groups, r.mean_group_size, r.ari,
+                          d.name().c_str(), d.observations.size(), d.drift_rms,
+                          c.correct_odometry != OdometryCorrection::Off && d.correction_applied
+                              ? format(" (scan-matched: %.2f m)", d.corrected_rms).c_str()
+                              : "",
+                          r.groups, r.mean_group_size, r.ari,
                           r.rooms_whole, r.rooms, r.rooms_found, r.rooms_pure, r.seconds,
                           r.warnings ? format("  (%zu warnings)", r.warnings).c_str() : "");
     std::cout.flush();
@@ -405,6 +417,7 @@ int writeLogs(const std::string& folder, const std::vector<std::string>& buildin
     std::vector<Eigen::Isometry3d> truth;
     for (const sim::Pose2D& pose : building.route) truth.push_back(sim::toIsometry(pose));
     const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
+    const std::vector<Eigen::Isometry3d> biased = sim::biasedDrift(truth);
     for (sim::Sensor sensor : sensors) {
       if (sensor == sim::Sensor::Depth || sensor == sim::Sensor::Lidar) continue;  // not a CARMEN log
       const sim::LaserModel laser = sensor == sim::Sensor::Laser360 ? sim::laser360() : sim::laser180();
@@ -416,7 +429,8 @@ int writeLogs(const std::string& folder, const std::vector<std::string>& buildin
             << " poses (obsgroup's scan simulator, examples/evaluate_grouping.cpp)\n";
         for (std::size_t k = 0; k < building.route.size(); ++k) {
           const auto ranges = building.plan.scan(building.route[k], laser, k);  // the seed of makeDatasets
-          const Eigen::Isometry3d& pose = source == PoseSource::Exact ? truth[k] : drifted[k];
+          const Eigen::Isometry3d& pose =
+              source == PoseSource::Exact ? truth[k] : source == PoseSource::Drift ? drifted[k] : biased[k];
           const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
           out << format("ROBOTLASER1 0 %.9f %.9f %.9f %.3f 0.01 0 %zu", laser.beamAngle(0, ranges.size()),
                         laser.field_of_view, step, laser.max_range, ranges.size());
@@ -698,7 +712,7 @@ const char* kUsage =
     "  --correct-odometry auto|off (auto: at the poses the command groups at, scan-matched when more consistent)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
     "selection (defaults: all):\n"
-    "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth[,lidar]  --poses exact,drift\n"
+    "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth[,lidar]  --poses exact,drift[,bias]\n"
     "real logs instead of the simulated buildings (each --log with its --labels, in order):\n"
     "  --log LOG --labels LABELS.json\n"
     "the selected laser datasets as CARMEN logs with their labels, for obsgroup partition and --log:\n"
