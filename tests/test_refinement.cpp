@@ -409,6 +409,19 @@ TEST(OdometryCorrection, BiasedOdometryOfALongRouteIsCorrected) {
   EXPECT_LT(report.corrected_blocked_share, 0.5 * report.input_blocked_share);
   EXPECT_TRUE(report.applied);
   EXPECT_LT(sim::rmsPositionError(posesOf(observations), truth), 0.1 * before) << before << " m before";
+  // The matched steps measure the bias, which is taken out of the steps kept as given.
+  EXPECT_NEAR(report.bias.scale, 1 / 1.02, 0.005);
+  EXPECT_NEAR(report.bias.yaw_per_metre * 180 / M_PI, -3.0, 0.1);
+  EXPECT_EQ(report.bias.turn_scale, 0.0);
+}
+
+TEST(OdometryCorrection, RandomDriftHasNoBias) {
+  OfficeRoute route = officeRoute(sim::Sensor::Laser360);
+  const std::vector<Eigen::Isometry3d> drifted = sim::drift(route.truth, 7);
+  for (std::size_t k = 0; k < drifted.size(); ++k) route.observations[k].pose = drifted[k];
+  const OdometryCorrectionReport report = correctOdometry(route.observations, OdometryCorrection::On);
+  EXPECT_GT(report.bias.steps, 50);
+  EXPECT_FALSE(report.bias.any());
 }
 
 TEST(OdometryCorrection, TheMapOfConsistentPosesHasFewBeamsThroughWalls) {

@@ -507,6 +507,12 @@ py::tuple correctOdometryOf(const std::vector<PyObservation>& observations, cons
   report["corrected_map_cells"] = r.corrected_cells;
   report["input_blocked_share"] = r.input_blocked_share;
   report["corrected_blocked_share"] = r.corrected_blocked_share;
+  py::dict bias;
+  bias["scale"] = r.bias.scale;
+  bias["yaw_deg_per_m"] = r.bias.yaw_per_metre * 180.0 / M_PI;
+  bias["turn_scale"] = r.bias.turn_scale;
+  bias["steps"] = r.bias.steps;
+  report["odometry_bias"] = bias;
   return py::make_tuple(corrected, report);
 }
 

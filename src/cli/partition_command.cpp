@@ -845,7 +845,12 @@ nlohmann::json correctPoses(const PartitionArgs& args, std::vector<Observation<P
           {"input_map_cells", r.input_cells},
           {"corrected_map_cells", r.corrected_cells},
           {"input_blocked_share", r.input_blocked_share},
-          {"corrected_blocked_share", r.corrected_blocked_share}};
+          {"corrected_blocked_share", r.corrected_blocked_share},
+          {"odometry_bias",
+           {{"scale", r.bias.scale},
+            {"yaw_deg_per_m", r.bias.yaw_per_metre * 180.0 / M_PI},
+            {"turn_scale", r.bias.turn_scale},
+            {"steps", r.bias.steps}}}};
 }
 
 template <typename PointT>

@@ -45,6 +45,36 @@ double consistencyAt(const PreparedMember& source, const PreparedMember& target,
 
 enum class StepOutcome { Matched, Kept, Unaligned };
 
+/// A step of a ground robot: a turn about the vertical and a move in the
+/// plane, within `tolerance` (a depth camera's match, in 6 DoF, tilts and
+/// climbs a little).
+bool groundStep(const Eigen::Isometry3d& step, double tolerance = 1e-9) {
+  return std::abs(step.linear()(2, 2) - 1) < tolerance && std::abs(step.translation().z()) < tolerance;
+}
+
+double yawOf(const Eigen::Isometry3d& pose) { return std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)); }
+
+double wrapped(double angle) { return std::atan2(std::sin(angle), std::cos(angle)); }
+
+/// The median of `values` when they lie on one side of `neutral` more often
+/// than chance allows (a sign test: the excess beyond three standard
+/// deviations of a fair coin, and at least 20 of them) and it differs from
+/// `neutral` by at least `least`, else `neutral`. The floor keeps a matcher's
+/// own faint leaning, which a long log makes significant, from being taken
+/// for the odometry's.
+double consistentMedian(std::vector<double> values, double neutral, double least) {
+  std::size_t above = 0, below = 0;
+  for (double v : values) {
+    above += v > neutral;
+    below += v < neutral;
+  }
+  const double decided = double(above + below);
+  if (decided < 20 || std::abs(double(above) - double(below)) <= 3.0 * std::sqrt(decided)) return neutral;
+  const auto middle = values.begin() + std::ptrdiff_t(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return std::abs(*middle - neutral) >= least ? *middle : neutral;
+}
+
 /// The step from the previous observation to `current`: the matched one
 /// when it aligns and is better by min_gain, else the input's.
 StepOutcome correctStep(const PreparedMember& current, const PreparedMember& previous, const Eigen::Isometry3d& input_step,
@@ -120,6 +150,57 @@ class StepMatcher {
     return {matched, static_cast<int>(sample.size())};
   }
 
+  /// The odometry's systematic error, from the steps scan matching changed
+  /// (ground steps only: no roll, pitch or climb), then taken out of the
+  /// steps it kept as given. A term is used only when most of those steps
+  /// err the same way (a sign test at three standard deviations): random
+  /// drift leaves the kept steps as they were.
+  void calibrateUnmatchedSteps(OdometryBias& bias) {
+    constexpr double kMinLength = 0.05;                   // metres: shorter steps say nothing of scale or yaw rate
+    constexpr double kDegree = 3.14159265358979323846 / 180.0;
+    constexpr double kStraight = 2.0 * kDegree;  // a step turning less goes straight
+    std::vector<double> scales, rates, turns;
+    std::vector<std::size_t> turning;
+    std::size_t used = 0;
+    for (std::size_t i = 1; i < poses_.size(); ++i) {
+      if (outcomes_[i] != StepOutcome::Matched) continue;
+      const Eigen::Isometry3d input = poses_[i - 1].inverse() * poses_[i];
+      if (!groundStep(input) || !groundStep(steps_[i], 1e-3)) continue;
+      const double length = input.translation().head<2>().norm();
+      const double error = wrapped(yawOf(steps_[i]) - yawOf(input));
+      ++used;
+      if (length >= kMinLength) scales.push_back(steps_[i].translation().head<2>().norm() / length);
+      if (std::abs(yawOf(input)) < kStraight) {
+        if (length >= kMinLength) rates.push_back(error / length);
+      } else {
+        turning.push_back(i);
+      }
+    }
+    bias.steps = static_cast<int>(used);
+    // Floors (docs/method.md): 1% of length, 0.25 degree per metre, 2% of a turn.
+    bias.scale = consistentMedian(scales, 1.0, 0.01);
+    bias.yaw_per_metre = consistentMedian(rates, 0.0, 0.25 * kDegree);
+    for (std::size_t i : turning) {
+      const Eigen::Isometry3d input = poses_[i - 1].inverse() * poses_[i];
+      const double length = input.translation().head<2>().norm();
+      const double error = wrapped(yawOf(steps_[i]) - yawOf(input)) - bias.yaw_per_metre * length;
+      turns.push_back(error / yawOf(input));
+    }
+    bias.turn_scale = consistentMedian(turns, 0.0, 0.02);
+    if (!bias.any()) return;
+    for (std::size_t i = 1; i < poses_.size(); ++i) {
+      if (outcomes_[i] == StepOutcome::Matched) continue;
+      const Eigen::Isometry3d input = poses_[i - 1].inverse() * poses_[i];
+      if (!groundStep(input)) continue;
+      Eigen::Isometry3d step = input;
+      const double length = input.translation().head<2>().norm();
+      step.translation().head<2>() *= bias.scale;
+      step.rotate(Eigen::AngleAxisd(bias.yaw_per_metre * length + bias.turn_scale * yawOf(input),
+                                    Eigen::Vector3d::UnitZ()));
+      steps_[i] = step;
+    }
+  }
+
   /// The poses chained from the first through every step; counts the outcomes.
   std::vector<Eigen::Isometry3d> chained(OdometryCorrectionReport& report) const {
     std::vector<Eigen::Isometry3d> corrected = poses_;
@@ -157,6 +238,7 @@ std::vector<Eigen::Isometry3d> scanMatchedPoses(const PointsOfObservation& point
   if (poses.size() < 2) return poses;
   StepMatcher matcher(points, poses, planar, parameters);
   matcher.matchAll(parameters.threads);
+  matcher.calibrateUnmatchedSteps(report.bias);
   return matcher.chained(report);
 }
 
@@ -292,6 +374,7 @@ OdometryCorrectionReport correctOdometry(const PointsOfObservation& points, std:
     }
   }
   matcher.matchAll(parameters.threads);
+  matcher.calibrateUnmatchedSteps(report.bias);
   std::vector<Eigen::Isometry3d> corrected = matcher.chained(report);
   if (planar) {
     const MapConsistency input = mapConsistency(points, poses, parameters.map_cell, parameters.threads);

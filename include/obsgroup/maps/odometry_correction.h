@@ -86,12 +86,29 @@ struct OdometryCorrectionParameters {
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
+/// A ground robot's odometry error, as scan matching measured it on the steps
+/// it changed (matched minus input): each step's length times `scale`, and
+/// its heading turned by `yaw_per_metre` for each metre and by `turn_scale`
+/// times its own turn (a miscalibrated wheel radius and track width). Each
+/// term is 0 (scale 1) unless a sign test over those steps finds it.
+struct OdometryBias {
+  double scale = 1.0;
+  double yaw_per_metre = 0.0;  ///< radians per metre
+  double turn_scale = 0.0;
+  int steps = 0;  ///< matched ground steps the estimate used
+  bool any() const { return scale != 1.0 || yaw_per_metre != 0.0 || turn_scale != 0.0; }
+};
+
 /// What the correction did.
 struct OdometryCorrectionReport {
   int steps = 0;      ///< observations after the first
   int matched = 0;    ///< steps the scan matching changed
   int kept = 0;       ///< input steps kept: the match was no better
   int unaligned = 0;  ///< input steps kept: the pair did not align
+  /// The odometry's systematic error, found on the matched steps and taken
+  /// out of the kept and unaligned ones (whose input error would otherwise
+  /// add up along the route); none found: OdometryBias's defaults.
+  OdometryBias bias;
   int sampled = 0;         ///< Auto: steps matched first, as a sample...
   int sample_matched = 0;  ///< ...and how many of them changed
   std::size_t input_cells = 0;      ///< occupied cells of the input poses' map
