@@ -1893,6 +1893,9 @@ TEST_F(Cli, DriftedOdometryIsCorrectedBeforeGroupingAndLocating) {
   EXPECT_LT(correction.at("corrected_map_cells").get<double>(), 0.5 * correction.at("input_map_cells").get<double>());
   EXPECT_LT(correction.at("corrected_blocked_share").get<double>(),
             0.8 * correction.at("input_blocked_share").get<double>());
+  // Its odometry over-counts turns: the matched steps say so, and the summary tells the user.
+  EXPECT_LT(correction.at("odometry_bias").at("turn_scale").get<double>(), -0.1);
+  EXPECT_NE(grouped.err.find("odometry calibration the matched steps found"), std::string::npos) << grouped.err;
   EXPECT_EQ(partition.at("parameters").at("correct_odometry"), "auto");
   std::map<int, int> place_of;
   for (std::size_t g = 0; g < partition.at("groups").size(); ++g)

@@ -602,6 +602,25 @@ void printOdometryCorrection(const io::RunRecord& run) {
     std::fprintf(stderr, "  poses corrected by scan matching: %d of %d steps changed (map %zu cells, %zu at the input poses)\n",
                  c.at("matched").get<int>(), c.at("steps").get<int>(), c.at("corrected_map_cells").get<std::size_t>(),
                  c.at("input_map_cells").get<std::size_t>());
+  // A robot's odometry calibration, as the matched steps measured it: worth telling its user.
+  const auto& bias = c.at("odometry_bias");
+  std::string terms;
+  const double scale = bias.at("scale").get<double>(), yaw = bias.at("yaw_deg_per_m").get<double>(),
+               turn = bias.at("turn_scale").get<double>();
+  char text[96];
+  if (scale != 1.0) {
+    std::snprintf(text, sizeof text, "%sstep lengths x %.3f", terms.empty() ? "" : ", ", scale);
+    terms += text;
+  }
+  if (yaw != 0.0) {
+    std::snprintf(text, sizeof text, "%sheading %+.2f degrees per metre", terms.empty() ? "" : ", ", yaw);
+    terms += text;
+  }
+  if (turn != 0.0) {
+    std::snprintf(text, sizeof text, "%sturns x %.2f", terms.empty() ? "" : ", ", 1 + turn);
+    terms += text;
+  }
+  if (!terms.empty()) std::fprintf(stderr, "  odometry calibration the matched steps found (applied to the others): %s\n", terms.c_str());
 }
 
 void printSummary(const PartitionArgs& args, const io::RunRecord& run, std::size_t observations) {
