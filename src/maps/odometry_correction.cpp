@@ -327,7 +327,6 @@ MapConsistency mapConsistency(const PointsOfObservation& points, const std::vect
   // the visibility model's clearance allows) and end short of their point
   // (its own wall, give or take a cell); past 8 m they say little indoors.
   constexpr double kStart = 0.3, kEndMargin = 0.5, kReach = 8.0;
-  std::vector<std::vector<Eigen::Vector2d>> world(poses.size());
   PlaneOccupancy occupancy(cell);
   for (std::size_t i = 0; i < poses.size(); ++i)
     for (const Eigen::Vector3f& p : points(i)) occupancy.add((poses[i] * p.cast<double>()).head<2>());
