@@ -72,6 +72,8 @@ def test_correct_odometry_reports_the_beams_through_walls(data):
     corrected, report = obsgroup.correct_odometry(scans)
     assert report["applied"]
     assert 0 < report["corrected_blocked_share"] < 0.8 * report["input_blocked_share"] <= 0.8
+    # its odometry over-counts turns, and the matched steps say by how much
+    assert report["odometry_bias"]["turn_scale"] < -0.1 and report["odometry_bias"]["steps"] > 100
 
 
 def test_the_defaults_are_the_commands():
