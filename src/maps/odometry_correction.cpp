@@ -3,6 +3,7 @@
 #include "refinement/pair_aligner.h"
 #include "refinement/prepared_member.h"
 #include "refinement/se3.h"
+#include "../overlap/region_cells.h"
 
 #include "obsgroup/common/parallel_for.h"
 
@@ -10,7 +11,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <tuple>
@@ -283,16 +283,13 @@ class PlaneOccupancy {
     const double end = std::min(length - end_margin, reach);
     if (!(end > start)) return false;
     const Eigen::Vector2d u = d / length;
-    const double step = cell_ / 2;  // every cell the beam crosses by more than a corner
-    std::int64_t last_x = std::numeric_limits<std::int64_t>::min(), last_y = last_x;
-    for (double t = start; t <= end; t += step) {
-      const auto [x, y] = cellOf(from + t * u);
-      if (x == last_x && y == last_y) continue;
-      last_x = x;
-      last_y = y;
-      if (occupied(x, y)) return true;
-    }
-    return false;
+    const Eigen::Vector2d a = (from + start * u) / cell_, b = (from + end * u) / cell_;
+    bool blocked = false;
+    region_cells::traverse<2>({a.x(), a.y()}, {b.x(), b.y()}, [&](const region_cells::Cell<2>& cell, double) {
+      blocked = occupied(cell[0], cell[1]);
+      return !blocked;
+    });
+    return blocked;
   }
 
  private:

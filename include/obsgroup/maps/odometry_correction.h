@@ -62,8 +62,8 @@ struct OdometryCorrectionParameters {
   /// 2D scans: the corrected poses are kept when the share of beams that
   /// pass through another scan's wall (mapConsistency) is at most this times
   /// the input map's. Measured: drifted runs of real floor plans, a real raw
-  /// odometry log and a 2 km building with biased odometry 0.11-0.56,
-  /// SLAM-corrected real logs 1.14-2.06 (docs/method.md). A count of occupied cells says the
+  /// odometry log and a 2 km building with biased odometry 0.13-0.57,
+  /// SLAM-corrected real logs 1.12-1.93 (docs/method.md). A count of occupied cells says the
   /// same on short logs, but drift that winds a long route over itself makes
   /// the drifted map the smaller one.
   double max_conflict_ratio = 0.8;
