@@ -605,21 +605,17 @@ void printOdometryCorrection(const io::RunRecord& run) {
   // A robot's odometry calibration, as the matched steps measured it: worth telling its user.
   const auto& bias = c.at("odometry_bias");
   std::string terms;
-  const double scale = bias.at("scale").get<double>(), yaw = bias.at("yaw_deg_per_m").get<double>(),
-               turn = bias.at("turn_scale").get<double>();
-  char text[96];
-  if (scale != 1.0) {
-    std::snprintf(text, sizeof text, "%sstep lengths x %.3f", terms.empty() ? "" : ", ", scale);
-    terms += text;
-  }
-  if (yaw != 0.0) {
-    std::snprintf(text, sizeof text, "%sheading %+.2f degrees per metre", terms.empty() ? "" : ", ", yaw);
-    terms += text;
-  }
-  if (turn != 0.0) {
-    std::snprintf(text, sizeof text, "%sturns x %.2f", terms.empty() ? "" : ", ", 1 + turn);
-    terms += text;
-  }
+  const auto term = [&terms](bool found, const char* format, double value) {
+    if (!found) return;
+    char text[64];
+    std::snprintf(text, sizeof text, format, value);
+    terms += (terms.empty() ? "" : ", ") + std::string(text);
+  };
+  const double scale = bias.at("scale").get<double>(), turn = bias.at("turn_scale").get<double>();
+  term(scale != 1.0, "step lengths x %.3f", scale);
+  term(bias.at("yaw_deg_per_m").get<double>() != 0.0, "heading %+.2f degrees per metre",
+       bias.at("yaw_deg_per_m").get<double>());
+  term(turn != 0.0, "turns x %.2f", 1 + turn);
   if (!terms.empty()) std::fprintf(stderr, "  odometry calibration the matched steps found (applied to the others): %s\n", terms.c_str());
 }
 
