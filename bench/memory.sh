@@ -50,11 +50,25 @@ print(f"`obsgroup partition --no-pictures`, default settings, the run of median 
 print()
 print("| scans | wall s | peak RSS MiB, max | " + " | ".join(f"{s} s" for s in stages) + " | groups |")
 print("|---" * (len(stages) + 4) + "|")
+# Every run writes a folder of its own, all removed after the table: a run
+# into a folder just emptied would time the file system, not obsgroup. On
+# ext4 without a journal, creating a file next to thousands deleted in the
+# last minutes scans past each of them (docs/performance.md): the 5,004
+# files of a 100,100-scan run then took 3 s more. Inodes count as recently
+# freed for up to five minutes, so a run of the script waits until the
+# folders the last one deleted are that old.
+stamp = os.path.join(work, "outputs_deleted_at")
+if os.path.exists(stamp):
+    wait = 360 - (time.time() - os.path.getmtime(stamp))
+    if wait > 0:
+        print(f"waiting {wait:.0f} s: the last run's folders were deleted {360 - wait:.0f} s ago", file=sys.stderr)
+        time.sleep(wait)
+outs = os.path.join(work, f"memory_outs_{os.getpid()}")
+os.makedirs(outs)
 for n in sizes:
     runs = []
-    for _ in range(repeats if n < 1000000 else 1):
-        out = os.path.join(work, f"memory_out_{n}")
-        subprocess.run(["rm", "-rf", out], check=True)
+    for r in range(repeats if n < 1000000 else 1):
+        out = os.path.join(outs, f"{n}_{r}")
         start = time.perf_counter()
         p = subprocess.Popen([exe, "partition", os.path.join(work, f"building_{n}.clf"), "--output", out, "-q", "--no-pictures"])
         _, status, usage = os.wait4(p.pid, 0)
@@ -65,6 +79,8 @@ for n in sizes:
     runs.sort(key=lambda r: r[0])
     wall, rss, t, groups = runs[len(runs) // 2]
     print(f"| {n:,} | {wall:.2f} | {max(r[1] for r in runs):,.0f} | " + " | ".join(f"{t[s]:.2f}" for s in stages) + f" | {groups:,} |")
+subprocess.run(["rm", "-rf", outs], check=True)
+open(stamp, "w").close()
 PY
 } > "$table"
 if [ -z "$output" ]; then

@@ -37,6 +37,19 @@ exe=$work/obsgroup
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 
 runs=${OBSGROUP_BENCH_RUNS:-5}
+# Each run writes a fresh folder, all removed at the end: a run into a folder
+# just emptied (by rm or by --force replacing it) would time the file system.
+# On ext4 without a journal, creating a file next to thousands deleted in the
+# last minutes scans past each of them (docs/performance.md). Inodes count
+# as recently freed for up to five minutes: a run of the script waits until
+# the folders the last one deleted are that old.
+if [ -f "$work/outputs_deleted_at" ]; then
+  wait=$((360 - ($(date +%s) - $(stat -c %Y "$work/outputs_deleted_at"))))
+  if [ "$wait" -gt 0 ]; then echo "waiting $wait s: the last run's folders were deleted recently" >&2; sleep "$wait"; fi
+fi
+outs=$work/outs_$$
+mkdir -p "$outs"
+trap 'rm -rf "$outs"; touch "$work/outputs_deleted_at"' EXIT
 
 # The sensed-space models and the options that select them: points is the
 # paper's method (--paper: eq. 16-18, mean split, Ncut threshold 1), free-space
@@ -58,12 +71,14 @@ model_options() {  # model
 # and the region models match cells, not points.
 run() {  # key label model input voxel
   local key=$1 label=$2 model=$3 input=$4 voxel=$5
-  local out=$work/out_$key
+  local out
   local queries=-1
   [ "$model" = points ] && queries=$(build/bench/count_point_queries "$input" 0.1 "$voxel")
   # shellcheck disable=SC2046  # model_options is split into words on purpose
   for r in $(seq "$runs"); do
-    /usr/bin/time -v -o "$work/time_${key}_$r" "$exe" partition "$input" -o "$out" --force -q --no-pictures \
+    # A folder of its own per run, removed after the table (see $outs).
+    out=$outs/${key}_$r
+    /usr/bin/time -v -o "$work/time_${key}_$r" "$exe" partition "$input" -o "$out" -q --no-pictures \
       --voxel "$voxel" $(model_options "$model")
     cp "$out/partition.json" "$work/partition_${key}_$r.json"
   done
