@@ -1,12 +1,14 @@
 // Google Benchmark micro-benchmarks of the core: one SSO pair, the whole
-// overlap stage, graph build, one eigen solve (dense and Spectra), and a full
-// recursive partition. Speed targets are checked here, never in unit tests.
+// overlap stage, graph build, one eigen solve (dense and Spectra), a full
+// recursive partition, and the places' pass over every beam. Speed targets are
+// checked here, never in unit tests.
 //
 //   bench_core --benchmark_filter=Fiedler
 #include "floor_plan.h"
 #include "to_cloud.h"
 
 #include <obsgroup/observation_grouping.h>
+#include <obsgroup/places/place_map.h>
 
 #include <benchmark/benchmark.h>
 
@@ -87,6 +89,24 @@ void BM_RecursivePartition(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(recursivePartition(W).groups.size());
 }
 BENCHMARK(BM_RecursivePartition)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+/// observeFloor on one thread: every beam of the simulated office walked
+/// through the places' grid (30 m laser, 720 beams a scan).
+void BM_ObserveFloor(benchmark::State& state) {
+  const auto obs = officeScans(static_cast<int>(state.range(0)));
+  SensedSpaceOverlap<pcl::PointXYZ> sso;
+  sso.setSensedSpaceModel(SensedSpaceModel::Visibility);
+  const WorldPoints world = sso.toWorld(obs);
+  const ObservationRegions regions = sso.computeRegions(obs, world);
+  std::vector<Eigen::Vector3d> sensors;
+  for (const auto& o : obs) sensors.push_back(o.pose.translation() - world.origin);
+  const PlacePointSource points_of = [&world](int i, std::vector<Eigen::Vector3f>&) {
+    return std::make_pair(world.begin(i), world.begin(i) + world.count(i));
+  };
+  for (auto _ : state)
+    benchmark::DoNotOptimize(observeFloor(regions, world.origin, points_of, sensors, {}, 1).occupancy.size());
+}
+BENCHMARK(BM_ObserveFloor)->Arg(500)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

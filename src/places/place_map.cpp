@@ -95,10 +95,45 @@ constexpr std::size_t kMaxCopiedBytes = std::size_t(1) << 28;
 /// it, a point within the obstacle band lies in it.
 enum CellSeen : std::uint8_t { kCrossed = 1, kPoint = 2, kPointInBand = 4 };
 
+/// One beam's walk through the grid's cells (Amanatides & Woo), from the
+/// sensor's cell up to, not into, the cell of its point.
+struct BeamWalk {
+  int x, y, step_x, step_y, steps;
+  double next_x, next_y, delta_x, delta_y;
+
+  /// `s` and `e`: the sensor and the point in cells of the grid.
+  BeamWalk(double sx, double sy, double ex, double ey, const FloorGrid& g) {
+    x = int(std::floor(sx)), y = int(std::floor(sy));
+    const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
+    const double dx = ex - sx, dy = ey - sy;
+    step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+    const double inf = std::numeric_limits<double>::infinity();
+    delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
+    next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
+    next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
+    // Beyond the grid a ray marks nothing: stop where it leaves for good.
+    steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
+  }
+  /// Marks the current cell crossed and moves to the next.
+  void step(const FloorGrid& g, std::uint8_t* seen) {
+    if (g.contains(x, y)) seen[g.index(x, y)] |= kCrossed;
+    if (next_x < next_y) {
+      next_x += delta_x;
+      x += step_x;
+    } else {
+      next_y += delta_y;
+      y += step_y;
+    }
+    --steps;
+  }
+};
+
 /// Marks in `seen` the cells a beam of an observation crosses on its way
 /// from the sensor to a point (seen from above; the point's own cell
-/// excluded), by a grid traversal (Amanatides & Woo), and the cells its
-/// points lie in.
+/// excluded), and the cells its points lie in. Two beams are walked at
+/// once: each step of a walk waits on the one before it, and two walks in
+/// turn overlap in the processor. Each beam's cells are its own walk's, so
+/// the bits are the same as one beam after another.
 void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::Vector3d& sensor,
                const PlaceOptions& options, std::vector<std::uint8_t>& seen) {
   const FloorGrid& g = f.grid;
@@ -106,34 +141,27 @@ void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::
   const Eigen::Vector2d corner = f.base + g.resolution * f.first.cast<double>();
   const double sx = (sensor.x() - corner.x()) / g.resolution;
   const double sy = (sensor.y() - corner.y()) / g.resolution;
-  for (const Eigen::Vector3f* p = points.begin; p != points.end; ++p) {
-    if (const auto k = f.indexOf(p->x(), p->y())) {
-      const double height = double(p->z()) - sensor.z();
-      seen[*k] |= std::uint8_t(kPoint | (height >= options.band_low && height <= options.band_high ? kPointInBand : 0));
+  std::uint8_t* cells = seen.data();
+  const auto beamTo = [&](const Eigen::Vector3f& p) {
+    if (const auto k = f.indexOf(p.x(), p.y())) {
+      const double height = double(p.z()) - sensor.z();
+      cells[*k] |= std::uint8_t(kPoint | (height >= options.band_low && height <= options.band_high ? kPointInBand : 0));
     }
-    const double ex = (double(p->x()) - corner.x()) / g.resolution;
-    const double ey = (double(p->y()) - corner.y()) / g.resolution;
-    int x = int(std::floor(sx)), y = int(std::floor(sy));
-    const int end_x = int(std::floor(ex)), end_y = int(std::floor(ey));
-    const double dx = ex - sx, dy = ey - sy;
-    const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
-    const double inf = std::numeric_limits<double>::infinity();
-    const double delta_x = dx != 0 ? std::abs(1 / dx) : inf, delta_y = dy != 0 ? std::abs(1 / dy) : inf;
-    double next_x = dx != 0 ? (dx > 0 ? std::floor(sx) + 1 - sx : sx - std::floor(sx)) * delta_x : inf;
-    double next_y = dy != 0 ? (dy > 0 ? std::floor(sy) + 1 - sy : sy - std::floor(sy)) * delta_y : inf;
-    // Beyond the grid a ray marks nothing: stop where it leaves for good.
-    const int steps = std::min(std::abs(end_x - x) + std::abs(end_y - y), 2 * (g.width + g.height) + 4);
-    for (int k = 0; k < steps; ++k) {
-      if (g.contains(x, y)) seen[g.index(x, y)] |= kCrossed;
-      if (next_x < next_y) {
-        next_x += delta_x;
-        x += step_x;
-      } else {
-        next_y += delta_y;
-        y += step_y;
-      }
+    return BeamWalk(sx, sy, (double(p.x()) - corner.x()) / g.resolution, (double(p.y()) - corner.y()) / g.resolution,
+                    g);
+  };
+  const Eigen::Vector3f* p = points.begin;
+  for (; p + 1 < points.end; p += 2) {
+    BeamWalk a = beamTo(p[0]), b = beamTo(p[1]);
+    while (a.steps > 0 && b.steps > 0) {
+      a.step(g, cells);
+      b.step(g, cells);
     }
+    while (a.steps > 0) a.step(g, cells);
+    while (b.steps > 0) b.step(g, cells);
   }
+  if (p != points.end)
+    for (BeamWalk a = beamTo(*p); a.steps > 0;) a.step(g, cells);
 }
 
 /// What every observation's beams say of each cell (CellSeen bits), in one
