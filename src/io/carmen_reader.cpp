@@ -303,9 +303,10 @@ struct ParsedSlice {
 
 bool isVertex(std::string_view message) { return message == "VERTEX2" || message == "VERTEX_SE2"; }
 
+/// `fields`: the caller's scratch, reused from line to line.
 void parseLine(std::string_view line, std::size_t line_number, const std::string& path, LaserSource source,
-               bool require_timestamps, ParsedSlice& out) {
-  const auto fields = splitFields(line);
+               bool require_timestamps, ParsedSlice& out, std::vector<std::string_view>& fields) {
+  splitFields(line, fields);
   if (fields.empty() || fields[0].front() == '#') return;
   const LineRef where{path, line_number};
   if (fields[0] == "PARAM") {
@@ -329,9 +330,10 @@ void parseLine(std::string_view line, std::size_t line_number, const std::string
 /// it and goes on when `skip_bad_lines`.
 void parseSlice(const NumberedLines& lines, std::size_t begin, std::size_t end, const std::string& path,
                 LaserSource source, const CarmenOptions& options, ParsedSlice& out) {
+  std::vector<std::string_view> fields;
   for (std::size_t k = begin; k < end; ++k) {
     try {
-      parseLine(lines[k].second, lines[k].first, path, source, options.require_timestamps, out);
+      parseLine(lines[k].second, lines[k].first, path, source, options.require_timestamps, out, fields);
     } catch (const InputError& e) {
       if (!options.skip_bad_lines) throw;
       out.bad_lines.push_back(e.what());
