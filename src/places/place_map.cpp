@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <list>
 #include <map>
@@ -150,9 +151,10 @@ void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::
     return BeamWalk(sx, sy, (double(p.x()) - corner.x()) / g.resolution, (double(p.y()) - corner.y()) / g.resolution,
                     g);
   };
-  const Eigen::Vector3f* p = points.begin;
-  for (; p + 1 < points.end; p += 2) {
-    BeamWalk a = beamTo(p[0]), b = beamTo(p[1]);
+  const std::ptrdiff_t count = points.end - points.begin;
+  std::ptrdiff_t k = 0;
+  for (; k + 1 < count; k += 2) {
+    BeamWalk a = beamTo(points.begin[k]), b = beamTo(points.begin[k + 1]);
     while (a.steps > 0 && b.steps > 0) {
       a.step(g, cells);
       b.step(g, cells);
@@ -160,8 +162,8 @@ void markBeams(const GridFrame& f, region_cells::PointSpan points, const Eigen::
     while (a.steps > 0) a.step(g, cells);
     while (b.steps > 0) b.step(g, cells);
   }
-  if (p != points.end)
-    for (BeamWalk a = beamTo(*p); a.steps > 0;) a.step(g, cells);
+  if (k < count)
+    for (BeamWalk a = beamTo(points.begin[k]); a.steps > 0;) a.step(g, cells);
 }
 
 /// What every observation's beams say of each cell (CellSeen bits), in one
