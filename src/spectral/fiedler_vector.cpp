@@ -256,9 +256,13 @@ class DeflatedLaplacianInverse {
   void perform_op(const double* x_in, double* y_out) const {
     Eigen::Map<const Eigen::VectorXd> x(x_in, n_);
     Eigen::Map<Eigen::VectorXd> y(y_out, n_);
-    const Eigen::VectorXd b = x - z0_ * z0_.dot(x);
-    const Eigen::VectorXd permuted_b = to_eliminated_ * b.head(n_ - 1);
-    y.head(n_ - 1) = order_ * ldlt_.solve(permuted_b);
+    // Into buffers kept over the solve's applications (about fifteen each,
+    // thousands of solves in a stream) rather than three fresh vectors each:
+    // the same operations, the same bits.
+    b_ = x - z0_ * z0_.dot(x);
+    permuted_b_ = to_eliminated_ * b_.head(n_ - 1);
+    solved_ = ldlt_.solve(permuted_b_);
+    y.head(n_ - 1) = order_ * solved_;
     y[n_ - 1] = 0.0;
     y -= z0_ * z0_.dot(y);
   }
@@ -268,6 +272,7 @@ class DeflatedLaplacianInverse {
   Eigen::VectorXd z0_;
   Permutation order_, to_eliminated_;
   PreorderedLDLT& ldlt_;
+  mutable Eigen::VectorXd b_, permuted_b_, solved_;
 };
 
 /// Spectra operator for P (I - L) P = P D^-1/2 W D^-1/2 P: its largest
