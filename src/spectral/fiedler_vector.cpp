@@ -121,28 +121,6 @@ Permutation maximumCardinalityPermutation(const WeightMatrix& A) {
   return order;
 }
 
-/// Whether the LDL^T factor of `upper` (a symmetric matrix's upper triangle,
-/// in elimination order) holds at most `limit` entries below its diagonal:
-/// the count of SimplicialLDLT's symbolic analysis (each column's entries
-/// found along the elimination tree), without its storage, and stopped as
-/// soon as it passes the limit.
-bool factorFitsWithin(const WeightMatrix& upper, Eigen::Index limit) {
-  const int n = int(upper.cols());
-  std::vector<int> parent(std::size_t(n), -1), tag(std::size_t(n), -1);
-  Eigen::Index entries = 0;
-  for (int k = 0; k < n; ++k) {
-    tag[std::size_t(k)] = k;
-    for (WeightMatrix::InnerIterator it(upper, k); it; ++it) {
-      for (int i = int(it.index()); i < k && tag[std::size_t(i)] != k; i = parent[std::size_t(i)]) {
-        if (parent[std::size_t(i)] == -1) parent[std::size_t(i)] = k;
-        tag[std::size_t(i)] = k;
-        if (++entries > limit) return false;
-      }
-    }
-  }
-  return true;
-}
-
 /// The fill-reducing elimination order of a symmetric matrix, as Eigen's
 /// orderings give it (entry k: the node eliminated k-th): the nodes by
 /// increasing rank when ranks are given (rank[k] for node k; extra entries
@@ -167,11 +145,60 @@ Permutation eliminationOrder(const WeightMatrix& A, const std::vector<int>& rank
 /// the matrix itself: the same factor, without the copies.
 class PreorderedLDLT : public Eigen::SimplicialLDLT<WeightMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> {
  public:
+  // Eigen keeps its "initialized" flag private to its base class; one
+  // analysis of a 1 x 1 matrix sets it for good (analyzeInOrderWithin cannot).
+  PreorderedLDLT() {
+    WeightMatrix one(1, 1);
+    one.insert(0, 0) = 1.0;
+    one.makeCompressed();
+    analyzePattern_preordered(one, true);
+  }
   void analyzeInOrder(const WeightMatrix& upper) { analyzePattern_preordered(upper, true); }
+  /// analyzePattern_preordered's symbolic analysis (each column's entries
+  /// found along the elimination tree), the same steps and the same result,
+  /// but given up (false) as soon as the factor would hold more than `limit`
+  /// entries below its diagonal. The check used to be a pass of its own before
+  /// the analysis: the same count twice, a twentieth of the stream's time.
+  bool analyzeInOrderWithin(const WeightMatrix& upper, Eigen::Index limit) {
+    const int n = int(upper.rows());
+    m_matrix.resize(n, n);
+    m_parent.resize(n);
+    m_nonZerosPerCol.resize(n);
+    tags_.assign(std::size_t(n), 0);
+    Eigen::Index entries = 0;
+    for (int k = 0; k < n; ++k) {
+      m_parent[k] = -1;
+      tags_[std::size_t(k)] = k;
+      m_nonZerosPerCol[k] = 0;
+      for (WeightMatrix::InnerIterator it(upper, k); it; ++it) {
+        for (int i = int(it.index()); i < k && tags_[std::size_t(i)] != k; i = m_parent[i]) {
+          if (m_parent[i] == -1) m_parent[i] = k;
+          ++m_nonZerosPerCol[i];
+          tags_[std::size_t(i)] = k;
+          if (++entries > limit) {
+            m_analysisIsOk = false;
+            return false;
+          }
+        }
+      }
+    }
+    int* outer = m_matrix.outerIndexPtr();
+    outer[0] = 0;
+    for (int k = 0; k < n; ++k) outer[k + 1] = outer[k] + m_nonZerosPerCol[k];  // LDL^T: no diagonal in the factor
+    m_matrix.resizeNonZeros(outer[n]);
+    m_info = Eigen::Success;
+    m_analysisIsOk = true;
+    m_factorizationIsOk = false;
+    return true;
+  }
   void factorizeInOrder(const WeightMatrix& upper) { factorize_preordered<true>(upper); }
   std::size_t factorBytes() const {
-    return std::size_t(m_matrix.data().allocatedSize()) * (sizeof(double) + sizeof(int));
+    return std::size_t(m_matrix.data().allocatedSize()) * (sizeof(double) + sizeof(int)) +
+           tags_.capacity() * sizeof(int);
   }
+
+ private:
+  std::vector<int> tags_;
 };
 
 }  // namespace
@@ -235,6 +262,7 @@ class DeflatedLaplacianInverse {
     };
     if (!rank.empty()) {
       permuteBy(eliminationOrder(grounded, rank, buffers.pattern));
+      ldlt_.analyzeInOrder(permuted);
     } else {
       // A node's own order, from its block alone. The blocks of route-like
       // graphs are nearly chordal, where maximum cardinality search orders
@@ -242,10 +270,11 @@ class DeflatedLaplacianInverse {
       // fills in (a graph of loops).
       const Eigen::Index below_diagonal = (grounded.nonZeros() - grounded.rows()) / 2;
       permuteBy(maximumCardinalityPermutation(grounded));
-      if (!factorFitsWithin(permuted, Eigen::Index(kMaxSearchFill * double(below_diagonal))))
+      if (!ldlt_.analyzeInOrderWithin(permuted, Eigen::Index(kMaxSearchFill * double(below_diagonal)))) {
         permuteBy(amdOrder(grounded, buffers.pattern));
+        ldlt_.analyzeInOrder(permuted);
+      }
     }
-    ldlt_.analyzeInOrder(permuted);
     ldlt_.factorizeInOrder(permuted);
     if (ldlt_.info() != Eigen::Success)
       throw EigenSolverError("Fiedler vector: the grounded Laplacian could not be factorised");
