@@ -18,7 +18,9 @@ Scores (micro-averaged over the visited rooms' floor that carries a place
 label): each room's match is the place holding most of its floor; precision
 is the sum of the overlaps over the sum of the matches' floor (a place that is
 the match of several rooms counts once per room), recall the sum of the
-overlaps over the rooms' floor. Both labelings are compared on cells of half
+overlaps over the rooms' floor. "Precision over the places' whole floor"
+counts each match's floor in every room of the plan, visited or not (a place
+that reaches into rooms the robot only looked into pays for it). Both labelings are compared on cells of half
 a segmentation pixel: where the place grid's edges fall on multiples of that
 (obsgroup's 0.2 m cells on a 0.05 m plan), each cell lies in one pixel and in
 one place cell.
@@ -79,12 +81,14 @@ def places_on_cells(outdir, shape, resolution, origin):
 
 
 def scores(room_of_cell, place_of_cell, rooms):
+    on_floor = (room_of_cell > 0) & (place_of_cell > 0)
+    whole_size = collections.Counter(place_of_cell[on_floor].tolist())  # a place's floor in any room, visited or not
     inside = np.isin(room_of_cell, rooms)
     floor = int(inside.sum())
     labelled = inside & (place_of_cell > 0)
     room, place = room_of_cell[labelled], place_of_cell[labelled]
     place_size = collections.Counter(place.tolist())
-    overlap = matched = room_cells = 0
+    overlap = matched = matched_whole = room_cells = 0
     for r in rooms:
         held = collections.Counter(place[room == r].tolist())
         if not held:
@@ -92,9 +96,11 @@ def scores(room_of_cell, place_of_cell, rooms):
         best, count = max(held.items(), key=lambda item: (item[1], -item[0]))
         overlap += count
         matched += place_size[best]
+        matched_whole += whole_size[best]
         room_cells += sum(held.values())
     return {"rooms": len(rooms), "precision": overlap / matched if matched else float("nan"),
             "recall": overlap / room_cells if room_cells else float("nan"),
+            "precision, whole places": overlap / matched_whole if matched_whole else float("nan"),
             "floor labelled": labelled.sum() / floor if floor else float("nan")}
 
 
@@ -133,7 +139,7 @@ def main():
         return
     for name, s in result.items():
         print(f"{name}: {s['rooms']} rooms, precision {s['precision']:.3f}, recall {s['recall']:.3f}, "
-              f"floor labelled {s['floor labelled']:.3f}")
+              f"floor labelled {s['floor labelled']:.3f}, precision over the places' whole floor {s['precision, whole places']:.3f}")
 
 
 if __name__ == "__main__":

@@ -333,6 +333,98 @@ void keepPoseCells(const GridFrame& f, const std::vector<Occupancy>& occupancy,
   }
 }
 
+/// 4-connected components of the cells `in` says belong, each of one label:
+/// the component id per cell (-1 outside) and the number of components.
+std::pair<std::vector<int>, int> componentsOf(const FloorGrid& g, const std::vector<int>& label,
+                                              const std::vector<char>& in) {
+  std::vector<int> component(label.size(), -1);
+  int count = 0;
+  std::vector<std::size_t> stack;
+  for (std::size_t start = 0; start < label.size(); ++start) {
+    if (!in[start] || component[start] >= 0) continue;
+    component[start] = count;
+    stack.assign(1, start);
+    while (!stack.empty()) {
+      const std::size_t c = stack.back();
+      stack.pop_back();
+      const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
+      const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+      for (int n = 0; n < 4; ++n) {
+        if (!g.contains(i + di[n], j + dj[n])) continue;
+        const std::size_t d = g.index(i + di[n], j + dj[n]);
+        if (in[d] && component[d] < 0 && label[d] == label[start]) {
+          component[d] = count;
+          stack.push_back(d);
+        }
+      }
+    }
+    ++count;
+  }
+  return {std::move(component), count};
+}
+
+/// Drops the floor a place holds only beyond a neck of two cells or less
+/// that none of its observations stood beyond: the fans its scans saw
+/// through a door at a slant, into rooms they did not enter (the visibility
+/// model stops a ray in the first wide cell past a door, but measures a door
+/// across the ray, so a ray crossing one at more than 45 degrees from its
+/// normal does not see it narrow). A place's *core* is its cells whose four
+/// neighbours are its own; the core's pieces within one cell of a cell where
+/// one of its observations stands are kept, with the cells next to them;
+/// the cells next to its other core pieces go, and then each piece of what
+/// is left that touches neither. A place none of whose core pieces is near
+/// its poses (a narrow corridor, a forward laser's place) keeps its floor.
+void dropFloorBeyondNecks(const GridFrame& f, const std::vector<std::vector<int>>& groups,
+                          const std::vector<Eigen::Vector3d>& sensor_origins, std::vector<int>& label) {
+  const FloorGrid& g = f.grid;
+  const std::size_t cells = label.size();
+  const int di[5] = {0, 1, -1, 0, 0}, dj[5] = {0, 0, 0, 1, -1};  // the cell and its four neighbours
+  const auto around = [&](std::size_t c, auto&& visit) {
+    const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
+    for (int n = 0; n < 5; ++n)
+      if (g.contains(i + di[n], j + dj[n])) visit(g.index(i + di[n], j + dj[n]));
+  };
+  std::vector<char> core(cells, 0);
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (label[c] == kNone) continue;
+    const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
+    bool inner = true;
+    for (int n = 1; n < 5 && inner; ++n)
+      inner = g.contains(i + di[n], j + dj[n]) && label[g.index(i + di[n], j + dj[n])] == label[c];
+    core[c] = inner;
+  }
+  const auto [core_piece, core_pieces] = componentsOf(g, label, core);
+  // The poses' cells, and the core pieces next to them, per place.
+  std::vector<char> seed(cells, 0), kept_piece(std::size_t(core_pieces), 0), place_kept(groups.size(), 0);
+  for (std::size_t k = 0; k < groups.size(); ++k)
+    for (int i : groups[k]) {
+      const auto c = f.indexOf(sensor_origins[std::size_t(i)].x(), sensor_origins[std::size_t(i)].y());
+      if (!c) continue;
+      if (label[*c] == int(k)) seed[*c] = 1;
+      around(*c, [&](std::size_t d) {
+        if (core[d] && label[d] == int(k)) kept_piece[std::size_t(core_piece[d])] = place_kept[k] = 1;
+      });
+    }
+  // Near a kept core piece: kept; else near another core piece of the place: dropped.
+  std::vector<char> near_kept(cells, 0), in(cells, 0);
+  for (std::size_t c = 0; c < cells; ++c)
+    if (core[c] && kept_piece[std::size_t(core_piece[c])])
+      around(c, [&](std::size_t d) { near_kept[d] |= char(label[d] == label[c]); });
+  for (std::size_t c = 0; c < cells; ++c) in[c] = label[c] != kNone;
+  for (std::size_t c = 0; c < cells; ++c)
+    if (core[c] && !kept_piece[std::size_t(core_piece[c])] && place_kept[std::size_t(label[c])])
+      around(c, [&](std::size_t d) {
+        if (label[d] == label[c] && !near_kept[d]) in[d] = 0;
+      });
+  const auto [piece, pieces] = componentsOf(g, label, in);
+  std::vector<char> keep_piece(std::size_t(pieces), 0);
+  for (std::size_t c = 0; c < cells; ++c)
+    if (in[c] && (near_kept[c] || seed[c])) keep_piece[std::size_t(piece[c])] = 1;
+  for (std::size_t c = 0; c < cells; ++c)
+    if (label[c] != kNone && place_kept[std::size_t(label[c])] && !(in[c] && keep_piece[std::size_t(piece[c])]))
+      label[c] = kNone;
+}
+
 /// Keeps a cell only when some 2x2 block of its label holds it (a morphological
 /// opening by a 2x2 square): one-cell-wide spokes and lines go.
 std::vector<int> openedLabels(const FloorGrid& g, const std::vector<int>& label) {
@@ -822,6 +914,7 @@ PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, std::
   const double cell_area = g.resolution * g.resolution;
   dropSpecks(label, piecesOf(g, label), std::size_t(std::ceil(options.min_piece_area / cell_area)));
   if (cells) keepPoseCells(f, map.occupancy, groups, sensor_origins, label);
+  if (cells) dropFloorBeyondNecks(f, groups, sensor_origins, label);
   const Pieces pieces = piecesOf(g, label);
 
   map.places.resize(groups.size());

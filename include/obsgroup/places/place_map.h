@@ -120,6 +120,9 @@ double twiceSignedArea(const std::vector<Eigen::Vector2d>& ring);
 /// - a place's cells that lie on no 2x2 block of its own (one-cell spokes
 ///   reaching through a door) and pieces below options.min_piece_area are
 ///   left to no place;
+/// - a place's floor beyond a neck of two cells or less that none of its
+///   observations stood beyond (a fan its scans saw through a door at a
+///   slant) is left to no place (docs/places.md);
 /// - outlines follow the cell edges (4-connected pieces), doors are the
 ///   short contacts between two places (PlaceOptions::max_door_width).
 /// `groups` are observation indices (Partition::groups), `place_ids` one id
