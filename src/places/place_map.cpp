@@ -333,15 +333,15 @@ void keepPoseCells(const GridFrame& f, const std::vector<Occupancy>& occupancy,
   }
 }
 
-/// 4-connected components of the cells `in` says belong, each of one label:
-/// the component id per cell (-1 outside) and the number of components.
-std::pair<std::vector<int>, int> componentsOf(const FloorGrid& g, const std::vector<int>& label,
-                                              const std::vector<char>& in) {
-  std::vector<int> component(label.size(), -1);
+/// Numbers the 4-connected components of the cells for which in(cell) holds,
+/// each of one label, into `component` (-1 elsewhere); returns their count.
+template <typename In>
+int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std::vector<int>& component) {
+  component.assign(label.size(), -1);
   int count = 0;
   std::vector<std::size_t> stack;
   for (std::size_t start = 0; start < label.size(); ++start) {
-    if (!in[start] || component[start] >= 0) continue;
+    if (component[start] >= 0 || !in(start)) continue;
     component[start] = count;
     stack.assign(1, start);
     while (!stack.empty()) {
@@ -352,7 +352,7 @@ std::pair<std::vector<int>, int> componentsOf(const FloorGrid& g, const std::vec
       for (int n = 0; n < 4; ++n) {
         if (!g.contains(i + di[n], j + dj[n])) continue;
         const std::size_t d = g.index(i + di[n], j + dj[n]);
-        if (in[d] && component[d] < 0 && label[d] == label[start]) {
+        if (component[d] < 0 && label[d] == label[start] && in(d)) {
           component[d] = count;
           stack.push_back(d);
         }
@@ -360,7 +360,7 @@ std::pair<std::vector<int>, int> componentsOf(const FloorGrid& g, const std::vec
     }
     ++count;
   }
-  return {std::move(component), count};
+  return count;
 }
 
 /// Drops the floor a place holds only beyond a neck of two cells or less
@@ -373,9 +373,11 @@ std::pair<std::vector<int>, int> componentsOf(const FloorGrid& g, const std::vec
 /// one of its observations stands are kept, with the cells next to them;
 /// the cells next to its other core pieces go, and then each piece of what
 /// is left that touches neither. A place none of whose core pieces is near
-/// its poses (a narrow corridor, a forward laser's place) keeps its floor.
+/// its poses (a corridor two cells wide) keeps its floor. Five bytes a cell
+/// (a flag byte and one component number), fewer than the owners took.
 void dropFloorBeyondNecks(const GridFrame& f, const std::vector<std::vector<int>>& groups,
                           const std::vector<Eigen::Vector3d>& sensor_origins, std::vector<int>& label) {
+  enum : std::uint8_t { kCore = 1, kSeed = 2, kNearKept = 4, kGone = 8 };
   const FloorGrid& g = f.grid;
   const std::size_t cells = label.size();
   const int di[5] = {0, 1, -1, 0, 0}, dj[5] = {0, 0, 0, 1, -1};  // the cell and its four neighbours
@@ -384,44 +386,46 @@ void dropFloorBeyondNecks(const GridFrame& f, const std::vector<std::vector<int>
     for (int n = 0; n < 5; ++n)
       if (g.contains(i + di[n], j + dj[n])) visit(g.index(i + di[n], j + dj[n]));
   };
-  std::vector<char> core(cells, 0);
+  std::vector<std::uint8_t> flags(cells, 0);
   for (std::size_t c = 0; c < cells; ++c) {
     if (label[c] == kNone) continue;
     const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
     bool inner = true;
     for (int n = 1; n < 5 && inner; ++n)
       inner = g.contains(i + di[n], j + dj[n]) && label[g.index(i + di[n], j + dj[n])] == label[c];
-    core[c] = inner;
+    if (inner) flags[c] |= kCore;
   }
-  const auto [core_piece, core_pieces] = componentsOf(g, label, core);
+  std::vector<int> piece;
+  const int core_pieces = componentsOf(g, label, [&](std::size_t c) { return flags[c] & kCore; }, piece);
   // The poses' cells, and the core pieces next to them, per place.
-  std::vector<char> seed(cells, 0), kept_piece(std::size_t(core_pieces), 0), place_kept(groups.size(), 0);
+  std::vector<char> kept_piece(std::size_t(core_pieces), 0), place_kept(groups.size(), 0);
   for (std::size_t k = 0; k < groups.size(); ++k)
     for (int i : groups[k]) {
       const auto c = f.indexOf(sensor_origins[std::size_t(i)].x(), sensor_origins[std::size_t(i)].y());
       if (!c) continue;
-      if (label[*c] == int(k)) seed[*c] = 1;
+      if (label[*c] == int(k)) flags[*c] |= kSeed;
       around(*c, [&](std::size_t d) {
-        if (core[d] && label[d] == int(k)) kept_piece[std::size_t(core_piece[d])] = place_kept[k] = 1;
+        if ((flags[d] & kCore) && label[d] == int(k)) kept_piece[std::size_t(piece[d])] = place_kept[k] = 1;
       });
     }
-  // Near a kept core piece: kept; else near another core piece of the place: dropped.
-  std::vector<char> near_kept(cells, 0), in(cells, 0);
+  // Near a kept core piece: kept; else near another core piece of the place: gone.
   for (std::size_t c = 0; c < cells; ++c)
-    if (core[c] && kept_piece[std::size_t(core_piece[c])])
-      around(c, [&](std::size_t d) { near_kept[d] |= char(label[d] == label[c]); });
-  for (std::size_t c = 0; c < cells; ++c) in[c] = label[c] != kNone;
-  for (std::size_t c = 0; c < cells; ++c)
-    if (core[c] && !kept_piece[std::size_t(core_piece[c])] && place_kept[std::size_t(label[c])])
+    if ((flags[c] & kCore) && kept_piece[std::size_t(piece[c])])
       around(c, [&](std::size_t d) {
-        if (label[d] == label[c] && !near_kept[d]) in[d] = 0;
+        if (label[d] == label[c]) flags[d] |= kNearKept;
       });
-  const auto [piece, pieces] = componentsOf(g, label, in);
+  for (std::size_t c = 0; c < cells; ++c)
+    if ((flags[c] & kCore) && !kept_piece[std::size_t(piece[c])] && place_kept[std::size_t(label[c])])
+      around(c, [&](std::size_t d) {
+        if (label[d] == label[c] && !(flags[d] & kNearKept)) flags[d] |= kGone;
+      });
+  const auto left = [&](std::size_t c) { return label[c] != kNone && !(flags[c] & kGone); };
+  const int pieces = componentsOf(g, label, left, piece);
   std::vector<char> keep_piece(std::size_t(pieces), 0);
   for (std::size_t c = 0; c < cells; ++c)
-    if (in[c] && (near_kept[c] || seed[c])) keep_piece[std::size_t(piece[c])] = 1;
+    if (left(c) && (flags[c] & (kNearKept | kSeed))) keep_piece[std::size_t(piece[c])] = 1;
   for (std::size_t c = 0; c < cells; ++c)
-    if (label[c] != kNone && place_kept[std::size_t(label[c])] && !(in[c] && keep_piece[std::size_t(piece[c])]))
+    if (label[c] != kNone && place_kept[std::size_t(label[c])] && !(left(c) && keep_piece[std::size_t(piece[c])]))
       label[c] = kNone;
 }
 
