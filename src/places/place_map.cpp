@@ -334,9 +334,12 @@ void keepPoseCells(const GridFrame& f, const std::vector<Occupancy>& occupancy,
 }
 
 /// Numbers the 4-connected components of the cells for which in(cell) holds,
-/// each of one label, into `component` (-1 elsewhere); returns their count.
-template <typename In>
-int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std::vector<int>& component) {
+/// each of one label, into `component` (-1 elsewhere), calling
+/// visit(component, cell) on each cell as the fill reaches it; returns their
+/// count.
+template <typename In, typename Visit>
+int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std::vector<int>& component,
+                 Visit&& visit) {
   component.assign(label.size(), -1);
   int count = 0;
   std::vector<std::size_t> stack;
@@ -347,6 +350,7 @@ int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std
     while (!stack.empty()) {
       const std::size_t c = stack.back();
       stack.pop_back();
+      visit(count, c);
       const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
       const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
       for (int n = 0; n < 4; ++n) {
@@ -361,6 +365,10 @@ int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std
     ++count;
   }
   return count;
+}
+template <typename In>
+int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std::vector<int>& component) {
+  return componentsOf(g, label, in, component, [](int, std::size_t) {});
 }
 
 /// Drops the floor a place holds only beyond a neck of two cells or less
@@ -454,32 +462,15 @@ struct Pieces {
 
 Pieces piecesOf(const FloorGrid& g, const std::vector<int>& label) {
   Pieces p;
-  p.piece_of.assign(label.size(), -1);
-  std::vector<std::size_t> stack;
-  for (std::size_t start = 0; start < label.size(); ++start) {
-    if (label[start] == kNone || p.piece_of[start] >= 0) continue;
-    const int id = int(p.cells.size());
-    p.cells.emplace_back();
-    p.label.push_back(label[start]);
-    stack.assign(1, start);
-    p.piece_of[start] = id;
-    while (!stack.empty()) {
-      const std::size_t c = stack.back();
-      stack.pop_back();
-      p.cells[id].push_back(c);
-      const int i = int(c % std::size_t(g.width)), j = int(c / std::size_t(g.width));
-      const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
-      for (int n = 0; n < 4; ++n) {
-        const int x = i + di[n], y = j + dj[n];
-        if (!g.contains(x, y)) continue;
-        const std::size_t d = g.index(x, y);
-        if (label[d] == label[start] && p.piece_of[d] < 0) {
-          p.piece_of[d] = id;
-          stack.push_back(d);
+  componentsOf(
+      g, label, [&](std::size_t c) { return label[c] != kNone; }, p.piece_of,
+      [&](int piece, std::size_t c) {
+        if (std::size_t(piece) == p.cells.size()) {
+          p.cells.emplace_back();
+          p.label.push_back(label[c]);
         }
-      }
-    }
-  }
+        p.cells[std::size_t(piece)].push_back(c);
+      });
   return p;
 }
 
