@@ -366,6 +366,7 @@ int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std
   }
   return count;
 }
+
 template <typename In>
 int componentsOf(const FloorGrid& g, const std::vector<int>& label, In&& in, std::vector<int>& component) {
   return componentsOf(g, label, in, component, [](int, std::size_t) {});
