@@ -20,10 +20,10 @@ is the sum of the overlaps over the sum of the matches' floor (a place that is
 the match of several rooms counts once per room), recall the sum of the
 overlaps over the rooms' floor. "Precision over the places' whole floor"
 counts each match's floor in every room of the plan, visited or not (a place
-that reaches into rooms the robot only looked into pays for it). Both labelings are compared on cells of half
-a segmentation pixel: where the place grid's edges fall on multiples of that
-(obsgroup's 0.2 m cells on a 0.05 m plan), each cell lies in one pixel and in
-one place cell.
+that reaches into rooms the robot only looked into pays for it). Both
+labelings are compared on cells of half a segmentation pixel: where the place
+grid's edges fall on multiples of that (obsgroup's 0.2 m cells on a 0.05 m
+plan), each cell lies in one pixel and in one place cell.
 
 --labels (a labels.json of a labelled log: "kinds" per region, "labels" per
 pose) adds the same scores without the rooms whose poses are mostly of a
@@ -82,7 +82,8 @@ def places_on_cells(outdir, shape, resolution, origin):
 
 def scores(room_of_cell, place_of_cell, rooms):
     on_floor = (room_of_cell > 0) & (place_of_cell > 0)
-    whole_size = collections.Counter(place_of_cell[on_floor].tolist())  # a place's floor in any room, visited or not
+    # A place's floor in any room of the plan, visited or not.
+    whole_size = collections.Counter(place_of_cell[on_floor].tolist())
     inside = np.isin(room_of_cell, rooms)
     floor = int(inside.sum())
     labelled = inside & (place_of_cell > 0)
@@ -139,7 +140,8 @@ def main():
         return
     for name, s in result.items():
         print(f"{name}: {s['rooms']} rooms, precision {s['precision']:.3f}, recall {s['recall']:.3f}, "
-              f"floor labelled {s['floor labelled']:.3f}, precision over the places' whole floor {s['precision, whole places']:.3f}")
+              f"floor labelled {s['floor labelled']:.3f}, "
+              f"precision over the places' whole floor {s['precision, whole places']:.3f}")
 
 
 if __name__ == "__main__":
