@@ -72,6 +72,7 @@ struct SplitCache::Store {
     std::vector<int> member_ids;
     int depth = 0;
     Decision decision;  // children by id
+    std::uint64_t key = 0;  // nodeKey(member_ids, depth)
   };
   std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
   std::size_t reused = 0, computed = 0;
@@ -100,7 +101,12 @@ struct SplitCache::Store {
   }
   void add(std::vector<int> member_ids, int depth, Decision decision) {
     const std::uint64_t key = nodeKey(member_ids, depth);
-    entries[key].push_back({std::move(member_ids), depth, std::move(decision)});
+    entries[key].push_back({std::move(member_ids), depth, std::move(decision), key});
+  }
+  /// Moves over an entry of another store, whose decision a run copied.
+  void take(Entry& entry) {
+    const std::uint64_t key = entry.key;
+    entries[key].push_back(std::move(entry));
   }
 };
 
@@ -140,6 +146,10 @@ class Partitioner {
     // eigen solve reuses the buffers of the solves before it on its thread.
     const std::size_t threads = std::size_t(threadCount(options.threads));
     if (workspaces_.size() < threads) workspaces_.resize(threads);
+    if (reuse_ && !reuse_->ids.empty()) {
+      index_of_id_.assign(std::size_t(reuse_->ids.back()) + 1, -1);
+      for (std::size_t k = 0; k < reuse_->ids.size(); ++k) index_of_id_[std::size_t(reuse_->ids[k])] = int(k);
+    }
   }
 
   Partition run() {
@@ -164,8 +174,9 @@ class Partitioner {
       // to solve are shared out: online, that is mostly one node a level,
       // which then runs on this thread without an OpenMP team.
       std::vector<std::size_t> to_solve;
+      std::vector<SplitCache::Store::Entry*> copied(frontier.size(), nullptr);
       for (std::size_t k = 0; k < frontier.size(); ++k)
-        if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k]) &&
+        if (!copyCachedDecision(out_.splits[frontier[k]], decisions[k], copied[k]) &&
             !takeGuessed(out_.splits[frontier[k]], decisions[k]))
           to_solve.push_back(k);
       // Online, the nodes to solve form a path, one node a level, each
@@ -199,7 +210,7 @@ class Partitioner {
       for (std::size_t k = 0; k < frontier.size(); ++k) {
         const int id = frontier[k];
         Decision& d = decisions[k];
-        if (reuse_) record(out_.splits[id], d);
+        if (reuse_) record(out_.splits[id], d, copied[k]);
         if (!d.warning.empty()) out_.warnings.push_back(std::move(d.warning));
         d.node.members = std::move(out_.splits[id].members);
         d.node.parent = out_.splits[id].parent;
@@ -230,17 +241,18 @@ class Partitioner {
   /// The previous run's decision of this node, when none of its members is
   /// a source: every entry that changed has a source at one end, so none of
   /// its block did, and its block of W, hence its decision, is the same.
-  bool copyCachedDecision(const SplitNode& current, Decision& d) const {
+  bool copyCachedDecision(const SplitNode& current, Decision& d, SplitCache::Store::Entry*& copied) const {
     if (!reuse_) return false;
     for (int i : current.members)
       if (reuse_->sources[i]) return false;
-    const auto* entry = reuse_->previous.find(idsOf(current.members), current.depth);
+    SplitCache::Store::Entry* entry = reuse_->previous.find(idsOf(current.members), current.depth);
     if (!entry) return false;
     d = entry->decision;
+    // A child's members are the node's, each of them in the graph.
     for (auto& child : d.children)
-      for (int& member : child)
-        member = int(std::lower_bound(reuse_->ids.begin(), reuse_->ids.end(), member) - reuse_->ids.begin());
+      for (int& member : child) member = index_of_id_[std::size_t(member)];
     d.from_cache = true;
+    copied = entry;
     return true;
   }
 
@@ -307,9 +319,8 @@ class Partitioner {
       std::vector<std::vector<int>> old_children(children.size()), predicted(children.size());
       for (std::size_t c = 0; c < children.size(); ++c)
         for (int id : children[c]) {
-          const auto found = std::lower_bound(reuse_->ids.begin(), reuse_->ids.end(), id);
-          if (found == reuse_->ids.end() || *found != id) continue;  // no longer in the graph
-          const int i = int(found - reuse_->ids.begin());
+          const int i = std::size_t(id) < index_of_id_.size() ? index_of_id_[std::size_t(id)] : -1;
+          if (i < 0) continue;  // no longer in the graph
           old_children[c].push_back(i);
           child_of_[std::size_t(i)] = int(c);
         }
@@ -362,11 +373,10 @@ class Partitioner {
 
   /// Keeps this node's decision, by ids, for the next run: a copied one is
   /// moved over from the previous run's (no node is visited twice in a run).
-  void record(const SplitNode& current, const Decision& d) {
+  void record(const SplitNode& current, const Decision& d, SplitCache::Store::Entry* copied) {
     if (d.from_cache) {
-      std::vector<int> ids = idsOf(current.members);
-      SplitCache::Store::Entry* entry = reuse_->previous.find(ids, current.depth);
-      reuse_->next.add(std::move(ids), current.depth, std::move(entry->decision));
+      // The entry it was copied from holds this node's ids and depth: moved over as it is.
+      reuse_->next.take(*copied);
       ++reuse_->next.reused;
       return;
     }
@@ -489,6 +499,7 @@ class Partitioner {
   bool speculate_ = false;            // solve the likely path ahead (guessPath)
   std::unordered_map<std::uint64_t, std::vector<Guessed>> guessed_;  // decisions solved ahead, by ids
   std::vector<int> child_of_;         // guessPath's scratch: a node's child, or -1
+  std::vector<int> index_of_id_;      // the node of each id in the graph, or -1
   std::vector<FiedlerWorkspace> own_workspaces_;  // this run's, unless the cache keeps them
   std::vector<FiedlerWorkspace>& workspaces_;
   Partition out_;
