@@ -78,6 +78,23 @@ TEST(ObservationGraph, MutualNeighboursKeepAnEdgeOnlyWhenBothEndsRankItAmongThei
   EXPECT_EQ(mutualNeighbourGraph(none, neighbourThresholds(none, 3)).rows(), 0);
 }
 
+TEST(ObservationGraph, MutualNeighboursIntoAReusedMatrixAreTheSameGraph) {
+  const WeightMatrix W =
+      buildWeightMatrix(5, {{0, 1, 0.9}, {0, 2, 0.8}, {0, 3, 0.3}, {1, 2, 0.7}, {3, 4, 0.6}}, 1.0);
+  const WeightMatrix small = buildWeightMatrix(2, {{0, 1, 0.5}});
+  WeightMatrix kept;
+  // A buffer that held a larger graph, then a smaller one: the same entries as the fresh graph each time.
+  for (const WeightMatrix* g : {&W, &small, &W}) {
+    mutualNeighbourGraph(*g, neighbourThresholds(*g, 2), kept);
+    const WeightMatrix fresh = mutualNeighbourGraph(*g, neighbourThresholds(*g, 2));
+    ASSERT_EQ(kept.rows(), fresh.rows());
+    ASSERT_EQ(kept.nonZeros(), fresh.nonZeros());
+    EXPECT_TRUE(kept.isCompressed());
+    EXPECT_EQ((WeightMatrix(kept) - fresh).norm(), 0.0);
+  }
+  EXPECT_THROW(mutualNeighbourGraph(kept, neighbourThresholds(kept, 2), kept), std::invalid_argument);
+}
+
 TEST(ObservationGraph, MutualNeighbourCountGrowsWithTheMedianNumberOfNeighbours) {
   // A path of 9 nodes: 2 neighbours each but the ends (median 2).
   std::vector<WeightedPair> path;

@@ -166,6 +166,7 @@ class OnlineGrouping {
   SplitCache cache_;
   Partition partition_;
   WeightMatrix W_;
+  WeightMatrix spare_W_;  // the W before W_, its storage reused for the next
   StableGroupIds group_ids_;
   std::vector<std::string> warnings_;
   int exact_interval_ = 1;

@@ -495,6 +495,13 @@ std::size_t IncrementalOverlap::recomputedLastUpdate() const { return state_->re
 WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const { return weightMatrix(diagonal, nullptr); }
 
 WeightMatrix IncrementalOverlap::weightMatrix(double diagonal, const WeightMatrix* previous) const {
+  WeightMatrix W;
+  weightMatrix(diagonal, previous, W);
+  return W;
+}
+
+void IncrementalOverlap::weightMatrix(double diagonal, const WeightMatrix* previous, WeightMatrix& W) const {
+  if (previous == &W) throw std::invalid_argument("weightMatrix: the output cannot be the previous matrix");
   State& s = *state_;
   if (!std::isfinite(diagonal) || diagonal < 0.0)
     throw std::invalid_argument("buildWeightMatrix: diagonal weight must be finite and >= 0");
@@ -513,36 +520,58 @@ WeightMatrix IncrementalOverlap::weightMatrix(double diagonal, const WeightMatri
                     previous->cols() == kept && previous->nonZeros() == s.matrix_entries && kept <= n &&
                     std::equal(s.matrix_slots.begin(), s.matrix_slots.end(), present.begin());
   s.changed_since_matrix.resize(s.slots.size(), 1);
+  const auto copied = [&](Eigen::Index k) { return copy && k < kept && !s.changed_since_matrix[present[k]]; };
+  // Written straight into the compressed arrays, sized up front, a kept
+  // column copied as one block: entry by entry, the copy of the unchanged
+  // columns was about a twentieth of an online update at 10,000 scans.
   std::size_t entries = 0;
-  for (int i : present) entries += s.slots[i].row.size();
-  WeightMatrix W(n, n);
-  W.reserve(Eigen::Index(entries + (diagonal != 0.0 ? present.size() : 0)));
   for (Eigen::Index k = 0; k < n; ++k) {
-    const int i = present[k];
-    W.startVec(k);
-    if (copy && k < kept && !s.changed_since_matrix[i]) {
-      for (WeightMatrix::InnerIterator it(*previous, k); it; ++it) W.insertBack(it.row(), k) = it.value();
+    if (copied(k)) {
+      entries += std::size_t(previous->outerIndexPtr()[k + 1] - previous->outerIndexPtr()[k]);
       continue;
     }
+    const auto& row = s.slots[present[k]].row;
+    entries += row.size() + (diagonal != 0.0 ? 1 : 0);
+  }
+  W.resize(n, n);  // compressed; its storage kept, with a tenth to spare as rows are added
+  W.data().resize(Eigen::Index(entries), 0.1);
+  int* outer = W.outerIndexPtr();
+  int* inner = W.innerIndexPtr();
+  double* value = W.valuePtr();
+  std::size_t at = 0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const int i = present[k];
+    outer[k] = int(at);
+    if (copied(k)) {
+      const int begin = previous->outerIndexPtr()[k], end = previous->outerIndexPtr()[k + 1];
+      std::copy(previous->innerIndexPtr() + begin, previous->innerIndexPtr() + end, inner + at);
+      std::copy(previous->valuePtr() + begin, previous->valuePtr() + end, value + at);
+      at += std::size_t(end - begin);
+      continue;
+    }
+    const auto put = [&](Eigen::Index row, double v) {
+      inner[at] = int(row);
+      value[at] = v;
+      ++at;
+    };
     bool diagonal_done = diagonal == 0.0;
     for (const PairCounts& p : s.slots[i].row) {
       if (!diagonal_done && p.j > i) {
-        W.insertBack(k, k) = diagonal;
+        put(k, diagonal);
         diagonal_done = true;
       }
       // Psi, eq. (18), with Pi of eq. (17) as SensedSpaceOverlap computes it.
       const double pi_ij = p.ij ? double(p.ij) / size(i) : 0.0;
       const double pi_ji = p.ji ? double(p.ji) / size(p.j) : 0.0;
-      W.insertBack(position[p.j], k) = i < p.j ? 0.5 * (pi_ij + pi_ji) : 0.5 * (pi_ji + pi_ij);
+      put(position[p.j], i < p.j ? 0.5 * (pi_ij + pi_ji) : 0.5 * (pi_ji + pi_ij));
     }
-    if (!diagonal_done) W.insertBack(k, k) = diagonal;
+    if (!diagonal_done) put(k, diagonal);
   }
-  W.finalize();
+  outer[n] = int(at);
   s.matrix_slots = present;
   s.matrix_diagonal = diagonal;
   s.matrix_entries = W.nonZeros();
   std::fill(s.changed_since_matrix.begin(), s.changed_since_matrix.end(), 0);
-  return W;
 }
 
 }  // namespace obsgroup

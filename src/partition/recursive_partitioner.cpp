@@ -111,7 +111,8 @@ struct SplitCache::Store {
 };
 
 SplitCache::SplitCache()
-    : store_(std::make_shared<Store>()), workspaces_(std::make_shared<std::vector<FiedlerWorkspace>>()) {}
+    : store_(std::make_shared<Store>()), workspaces_(std::make_shared<std::vector<FiedlerWorkspace>>()),
+      kept_(std::make_shared<WeightMatrix>()) {}
 void SplitCache::clear() { *store_ = Store{}; }
 std::size_t SplitCache::reusedNodes() const { return store_->reused; }
 std::size_t SplitCache::computedNodes() const { return store_->computed; }
@@ -703,7 +704,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   next->weights_checked = true;
   next->ids = ids;
   const int k = neighbourCount(W, options);
-  WeightMatrix kept;
+  WeightMatrix& kept = *cache.kept_;
   std::vector<char> moved_sources;
   if (k > 0) {
     // A row that did not change has the threshold it had, for the same k.
@@ -714,7 +715,7 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     for (std::size_t n = 0; n < ids.size(); ++n)
       if (last.neighbour_count != k || std::isnan(before[n])) rows[n] = 1;
     updateNeighbourThresholds(W, k, rows, thresholds);
-    kept = mutualNeighbourGraph(W, thresholds);
+    mutualNeighbourGraph(W, thresholds, kept);
     moved_sources = keptEntrySources(W, sources, before, thresholds, k, last);
     next->neighbour_count = k;
     next->threshold_ids = ids;

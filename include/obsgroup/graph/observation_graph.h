@@ -82,5 +82,7 @@ void updateNeighbourThresholds(const WeightMatrix& W, int k, const std::vector<c
 /// above the thresholds of both i and j (neighbourThresholds), otherwise
 /// dropped; the diagonal is kept. Symmetric when W is.
 WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds);
+/// The same into `kept`, whose storage is reused (`kept` must not be `W`).
+void mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds, WeightMatrix& kept);
 
 }  // namespace obsgroup

@@ -174,7 +174,10 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
   const std::vector<int> changed_slots = overlap_->update(params_.threads, interrupt_);
   out.observations_recomputed = overlap_->recomputedLastUpdate();
   const std::vector<int> ids = overlap_->slots();
-  W_ = overlap_->weightMatrix(params_.diagonal_weight, &W_);  // the unchanged columns copied
+  // Into the matrix of the update before last, whose storage is reused; the
+  // unchanged columns copied from the last one.
+  overlap_->weightMatrix(params_.diagonal_weight, &W_, spare_W_);
+  W_.swap(spare_W_);
   pending_.resize(slots_.size(), 0);
   for (int slot : changed_slots) pending_[slot] = 1;
   pending_sources_.resize(slots_.size(), 0);

@@ -73,6 +73,10 @@ class IncrementalOverlap {
   /// held moved to another position, as after a removal). Both overloads
   /// note what they built for the next call: not from two threads at once.
   WeightMatrix weightMatrix(double diagonal, const WeightMatrix* previous) const;
+  /// The same, into `out`, whose storage is reused (an online update
+  /// alternates two matrices instead of allocating one each time); `out`
+  /// must not be `previous`.
+  void weightMatrix(double diagonal, const WeightMatrix* previous, WeightMatrix& out) const;
   /// Points of a slot (M of eq. 17 for points); cells of its region for the
   /// region models.
   std::size_t pointCount(int slot) const;

@@ -144,6 +144,8 @@ class SplitCache {
   /// next: the nodes solved again after an insert are about as large as
   /// last time's (see FiedlerWorkspace).
   std::shared_ptr<std::vector<FiedlerWorkspace>> workspaces_;
+  /// The mutual-neighbour graph of the last run, its storage reused by the next.
+  std::shared_ptr<WeightMatrix> kept_;
 };
 
 /// recursivePartition reusing `cache`'s decisions, then leaving this run's in
