@@ -552,13 +552,22 @@ void refineBoundaries(const WeightMatrix& W, int passes, int min_size, Partition
   const int k_groups = static_cast<int>(p.groups.size());
   std::vector<double> sum(k_groups, 0.0);
   std::vector<int> touched;
+  // An observation's choice depends on its row, its neighbours' groups and
+  // the sizes of those groups and its own. After the first sweep only the
+  // observations that moved, their neighbours and the members of a group
+  // whose size changed (and those members' neighbours) can choose otherwise:
+  // the others are not visited again, their choice would be the same (to
+  // stay). With a minimum size above 1 a choice also depends on the moves
+  // before it in the sweep, and every sweep visits all.
+  std::vector<char> visit(std::size_t(n), 1);
+  std::vector<int> size(k_groups, 0);
+  for (int g : group_of) ++size[g];
   for (int pass = 0; pass < passes; ++pass) {
-    std::vector<int> size(k_groups, 0);
-    for (int g : group_of) ++size[g];
     std::vector<int> next = group_of;
     std::vector<int> remaining = size;  // as the moves of this sweep leave them
-    bool moved = false;
+    std::vector<int> moves;
     for (int i = 0; i < n; ++i) {
+      if (!visit[std::size_t(i)]) continue;
       touched.clear();
       for (WeightMatrix::InnerIterator it(W, i); it; ++it) {
         if (it.row() == i) continue;  // the diagonal says nothing of i's group
@@ -580,10 +589,25 @@ void refineBoundaries(const WeightMatrix& W, int passes, int min_size, Partition
       if (best == own || (min_size > 1 && remaining[own] - 1 < min_size)) continue;
       --remaining[own];
       next[i] = best;
-      moved = true;
+      moves.push_back(i);
+    }
+    if (moves.empty()) break;
+    std::vector<char> resized(std::size_t(k_groups), 0);
+    for (int i : moves) {
+      resized[std::size_t(group_of[i])] = resized[std::size_t(next[i])] = 1;
+      --size[group_of[i]];
+      ++size[next[i]];
     }
     group_of = std::move(next);
-    if (!moved) break;
+    if (min_size > 1) continue;  // every observation visited again
+    std::fill(visit.begin(), visit.end(), 0);
+    const auto visitWithNeighbours = [&](int i) {
+      visit[std::size_t(i)] = 1;
+      for (WeightMatrix::InnerIterator it(W, i); it; ++it) visit[std::size_t(it.row())] = 1;
+    };
+    for (int i : moves) visitWithNeighbours(i);
+    for (int i = 0; i < n; ++i)
+      if (resized[std::size_t(group_of[i])]) visitWithNeighbours(i);
   }
   std::vector<std::vector<int>> groups(k_groups);
   for (int i = 0; i < n; ++i) groups[group_of[i]].push_back(i);
