@@ -374,40 +374,48 @@ constexpr std::size_t kMaxKeptBytes = std::size_t(256) << 20;
 
 }  // namespace
 
-/// Tarjan and Yannakakis (1984): unnumbered nodes wait in doubly linked
-/// lists by their count of numbered neighbours. O(nodes + entries).
+/// Tarjan and Yannakakis (1984): unnumbered nodes wait in buckets by their
+/// count of numbered neighbours. O(nodes + entries). A count only grows, so
+/// a node enters each bucket at most once: the buckets are stacks in one
+/// pool, and a node whose count has grown past a bucket, or that is
+/// numbered, is dropped from it when met. The node taken is the last one to
+/// enter the fullest bucket (the first among equal counts at the start, the
+/// lowest index), as with doubly linked lists, without unlinking.
 std::vector<int> maximumCardinalityOrder(const WeightMatrix& A) {
   const int n = int(A.cols());
   const auto size = std::size_t(n);
-  std::vector<int> count(size, 0), next(size, -1), previous(size, -1), head(size + 1, -1);
+  std::vector<int> count(size, 0), head(size + 1, -1);
+  std::vector<int> pool_node, pool_next;  // the stacks' entries
+  pool_node.reserve(size + std::size_t(A.nonZeros()));
+  pool_next.reserve(size + std::size_t(A.nonZeros()));
+  const auto push = [&](int c, int v) {
+    pool_node.push_back(v);
+    pool_next.push_back(head[std::size_t(c)]);
+    head[std::size_t(c)] = int(pool_node.size()) - 1;
+  };
   std::vector<char> numbered(size, 0);
-  const auto unlink = [&](int v) {
-    if (previous[v] >= 0) next[previous[v]] = next[v];
-    else head[count[v]] = next[v];
-    if (next[v] >= 0) previous[next[v]] = previous[v];
-  };
-  const auto link = [&](int v) {  // at the head: the lowest index first among equal counts at the start
-    previous[v] = -1;
-    next[v] = head[count[v]];
-    if (next[v] >= 0) previous[next[v]] = v;
-    head[count[v]] = v;
-  };
-  for (int v = n - 1; v >= 0; --v) link(v);
+  for (int v = n - 1; v >= 0; --v) push(0, v);
   int most = 0;
   std::vector<int> eliminated(size);
   for (int k = n - 1; k >= 0; --k) {
-    while (head[most] < 0) --most;
-    const int v = head[most];
-    unlink(v);
-    numbered[v] = 1;
+    int v = -1;
+    while (v < 0) {
+      const int top = head[std::size_t(most)];
+      if (top < 0) {
+        --most;
+        continue;
+      }
+      head[std::size_t(most)] = pool_next[std::size_t(top)];
+      const int candidate = pool_node[std::size_t(top)];
+      if (!numbered[std::size_t(candidate)] && count[std::size_t(candidate)] == most) v = candidate;
+    }
+    numbered[std::size_t(v)] = 1;
     eliminated[std::size_t(k)] = v;
     for (WeightMatrix::InnerIterator it(A, v); it; ++it) {
       const int u = int(it.row());
-      if (numbered[u]) continue;
-      unlink(u);
-      ++count[u];
-      link(u);
-      most = std::max(most, count[u]);
+      if (numbered[std::size_t(u)]) continue;
+      push(++count[std::size_t(u)], u);
+      most = std::max(most, count[std::size_t(u)]);
     }
   }
   return eliminated;
