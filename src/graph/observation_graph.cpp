@@ -183,14 +183,11 @@ void updateNeighbourThresholds(const WeightMatrix& W, int k, const std::vector<c
     if (rows[std::size_t(j)]) thresholds[std::size_t(j)] = neighbourThreshold(W, j, k, row);
 }
 
-WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds) {
-  WeightMatrix kept;
-  mutualNeighbourGraph(W, thresholds, kept);
-  kept.data().squeeze();  // the dropped entries' storage back
-  return kept;
-}
+namespace {
 
-void mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds, WeightMatrix& kept) {
+/// mutualNeighbourGraph into `kept`, its storage grown (when it must) with
+/// `spare` of W's entries to spare.
+void keepMutual(const WeightMatrix& W, const std::vector<double>& thresholds, WeightMatrix& kept, double spare) {
   if (Eigen::Index(thresholds.size()) != W.outerSize())
     throw std::invalid_argument("mutualNeighbourGraph: one threshold per node expected");
   if (&kept == &W) throw std::invalid_argument("mutualNeighbourGraph: the output cannot be W");
@@ -199,7 +196,7 @@ void mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thre
   // online update to the next (a copy of W pruned took a twentieth of one).
   const Eigen::Index n = W.outerSize();
   kept.resize(W.rows(), W.cols());
-  kept.data().resize(W.nonZeros(), 0.1);
+  kept.data().resize(W.nonZeros(), spare);
   int* outer = kept.outerIndexPtr();
   int* inner = kept.innerIndexPtr();
   double* value = kept.valuePtr();
@@ -219,6 +216,19 @@ void mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thre
   }
   outer[n] = int(at);
   kept.data().resize(at);  // the capacity stays
+}
+
+}  // namespace
+
+WeightMatrix mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds) {
+  WeightMatrix kept;
+  keepMutual(W, thresholds, kept, 0.0);
+  kept.data().squeeze();  // the dropped entries' storage back
+  return kept;
+}
+
+void mutualNeighbourGraph(const WeightMatrix& W, const std::vector<double>& thresholds, WeightMatrix& kept) {
+  keepMutual(W, thresholds, kept, 0.1);  // online, W grows a little at every update
 }
 
 }  // namespace obsgroup

@@ -497,6 +497,7 @@ WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const { return we
 WeightMatrix IncrementalOverlap::weightMatrix(double diagonal, const WeightMatrix* previous) const {
   WeightMatrix W;
   weightMatrix(diagonal, previous, W);
+  W.data().squeeze();  // returned: no room kept for growth
   return W;
 }
 
@@ -517,7 +518,8 @@ void IncrementalOverlap::weightMatrix(double diagonal, const WeightMatrix* previ
   // are as they were, or the row would have been marked changed.
   const Eigen::Index kept = Eigen::Index(s.matrix_slots.size());
   const bool copy = previous && diagonal == s.matrix_diagonal && previous->rows() == kept &&
-                    previous->cols() == kept && previous->nonZeros() == s.matrix_entries && kept <= n &&
+                    previous->cols() == kept && previous->isCompressed() && previous->nonZeros() == s.matrix_entries &&
+                    kept <= n &&
                     std::equal(s.matrix_slots.begin(), s.matrix_slots.end(), present.begin());
   s.changed_since_matrix.resize(s.slots.size(), 1);
   const auto copied = [&](Eigen::Index k) { return copy && k < kept && !s.changed_since_matrix[present[k]]; };
