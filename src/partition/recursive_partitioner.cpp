@@ -546,50 +546,76 @@ void checkWeights(const WeightMatrix& W, const std::vector<char>* rows = nullptr
 /// With a minimum group size above 1, a move that would leave its group
 /// smaller is not made (observations in index order), so that the groups keep
 /// the size the tree guaranteed; with 1, a group may empty and disappear.
-void refineBoundaries(const WeightMatrix& W, int passes, int min_size, Partition& p) {
+void refineBoundaries(const WeightMatrix& W, int passes, int min_size, int threads, Partition& p) {
   const int n = static_cast<int>(W.rows());
   std::vector<int> group_of = p.group_of;
   const int k_groups = static_cast<int>(p.groups.size());
-  std::vector<double> sum(k_groups, 0.0);
-  std::vector<int> touched;
   // An observation's choice depends on its row, its neighbours' groups and
   // the sizes of those groups and its own. After the first sweep only the
   // observations that moved, their neighbours and the members of a group
   // whose size changed (and those members' neighbours) can choose otherwise:
   // the others are not visited again, their choice would be the same (to
   // stay). With a minimum size above 1 a choice also depends on the moves
-  // before it in the sweep, and every sweep visits all.
+  // before it in the sweep, and every sweep visits all, in order.
   std::vector<char> visit(std::size_t(n), 1);
   std::vector<int> size(k_groups, 0);
   for (int g : group_of) ++size[g];
+  struct Scratch {
+    std::vector<double> sum;
+    std::vector<int> touched;
+  };
+  const auto makeScratch = [k_groups] { return Scratch{std::vector<double>(std::size_t(k_groups), 0.0), {}}; };
+  // The group with the highest mean weight to i, its own counted without i.
+  const auto bestGroup = [&](int i, Scratch& s) {
+    std::vector<double>& sum = s.sum;
+    std::vector<int>& touched = s.touched;
+    touched.clear();
+    for (WeightMatrix::InnerIterator it(W, i); it; ++it) {
+      if (it.row() == i) continue;  // the diagonal says nothing of i's group
+      const int g = group_of[it.row()];
+      if (sum[g] == 0.0) touched.push_back(g);
+      sum[g] += it.value();
+    }
+    const int own = group_of[i];
+    const double own_mean = size[own] > 1 ? sum[own] / (size[own] - 1) : 0.0;
+    int best = own;
+    double best_mean = own_mean;
+    std::sort(touched.begin(), touched.end());
+    for (int g : touched) {
+      if (g == own) continue;
+      const double mean = sum[g] / size[g];
+      if (mean > best_mean) best = g, best_mean = mean;
+    }
+    for (int g : touched) sum[g] = 0.0;
+    return best;
+  };
+  // Without a minimum size the observations of a sweep are independent:
+  // decided on every thread in blocks, the moves then read in order.
+  constexpr int kBlock = 1024;
+  const bool in_parallel = min_size <= 1 && n > kBlock && threadCount(threads) > 1;
   for (int pass = 0; pass < passes; ++pass) {
     std::vector<int> next = group_of;
-    std::vector<int> remaining = size;  // as the moves of this sweep leave them
     std::vector<int> moves;
-    for (int i = 0; i < n; ++i) {
-      if (!visit[std::size_t(i)]) continue;
-      touched.clear();
-      for (WeightMatrix::InnerIterator it(W, i); it; ++it) {
-        if (it.row() == i) continue;  // the diagonal says nothing of i's group
-        const int g = group_of[it.row()];
-        if (sum[g] == 0.0) touched.push_back(g);
-        sum[g] += it.value();
+    if (in_parallel) {
+      const std::size_t blocks = std::size_t((n + kBlock - 1) / kBlock);
+      parallelForWithScratch(blocks, threads, 1, makeScratch, [&](std::size_t b, Scratch& s) {
+        const int end = std::min(n, int(b + 1) * kBlock);
+        for (int i = int(b) * kBlock; i < end; ++i)
+          if (visit[std::size_t(i)]) next[i] = bestGroup(i, s);
+      });
+      for (int i = 0; i < n; ++i)
+        if (next[i] != group_of[i]) moves.push_back(i);
+    } else {
+      Scratch s = makeScratch();
+      std::vector<int> remaining = size;  // as the moves of this sweep leave them
+      for (int i = 0; i < n; ++i) {
+        if (!visit[std::size_t(i)]) continue;
+        const int own = group_of[i], best = bestGroup(i, s);
+        if (best == own || (min_size > 1 && remaining[own] - 1 < min_size)) continue;
+        --remaining[own];
+        next[i] = best;
+        moves.push_back(i);
       }
-      const int own = group_of[i];
-      const double own_mean = size[own] > 1 ? sum[own] / (size[own] - 1) : 0.0;
-      int best = own;
-      double best_mean = own_mean;
-      std::sort(touched.begin(), touched.end());
-      for (int g : touched) {
-        if (g == own) continue;
-        const double mean = sum[g] / size[g];
-        if (mean > best_mean) best = g, best_mean = mean;
-      }
-      for (int g : touched) sum[g] = 0.0;
-      if (best == own || (min_size > 1 && remaining[own] - 1 < min_size)) continue;
-      --remaining[own];
-      next[i] = best;
-      moves.push_back(i);
     }
     if (moves.empty()) break;
     std::vector<char> resized(std::size_t(k_groups), 0);
@@ -695,7 +721,8 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
   if (k > 0) kept = mutualNeighbourGraph(W, neighbourThresholds(W, k));
   const WeightMatrix& graph = k > 0 ? kept : W;
   Partition partition = Partitioner(graph, options).run();
-  if (options.boundary_passes > 0) refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), partition);
+  if (options.boundary_passes > 0)
+    refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), options.threads, partition);
   return partition;
 }
 
@@ -751,7 +778,8 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
     Partition partition = Partitioner(graph, options, &reuse).run();
     cache.store_ = std::move(next);
     // After the tree, from all of the graph: the same as the batch's, whatever was reused.
-    if (options.boundary_passes > 0) refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), partition);
+    if (options.boundary_passes > 0)
+      refineBoundaries(graph, options.boundary_passes, std::max(1, options.min_group_size), options.threads, partition);
     return partition;
   } catch (...) {
     cache.clear();  // partly moved on: the next run computes every node
