@@ -111,21 +111,20 @@ WeightMatrix inducedSubgraph(const WeightMatrix& W, const std::vector<int>& memb
 
 std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W) {
   const int n = static_cast<int>(W.outerSize());
-  std::vector<int> label(n, -1);
-  std::vector<std::vector<int>> components;
+  std::vector<int> label(n, -1), sizes;
   std::vector<int> stack;
   // Seeds are visited in ascending order, so components come out ordered by
   // their smallest node.
   for (int seed = 0; seed < n; ++seed) {
     if (label[seed] >= 0) continue;
-    const int c = static_cast<int>(components.size());
-    components.emplace_back();
+    const int c = static_cast<int>(sizes.size());
+    sizes.push_back(0);
     label[seed] = c;
     stack.push_back(seed);
     while (!stack.empty()) {
       const int u = stack.back();
       stack.pop_back();
-      components[c].push_back(u);
+      ++sizes[c];
       for (WeightMatrix::InnerIterator it(W, u); it; ++it) {
         const int v = static_cast<int>(it.row());
         if (v == u || it.value() == 0.0 || label[v] >= 0) continue;
@@ -133,8 +132,12 @@ std::vector<std::vector<int>> connectedComponents(const WeightMatrix& W) {
         stack.push_back(v);
       }
     }
-    std::sort(components[c].begin(), components[c].end());
   }
+  // Each component's nodes ascending, by one pass over the labels rather
+  // than a sort of each (a connected graph, the common case, is one list).
+  std::vector<std::vector<int>> components(sizes.size());
+  for (std::size_t c = 0; c < sizes.size(); ++c) components[c].reserve(std::size_t(sizes[c]));
+  for (int u = 0; u < n; ++u) components[std::size_t(label[u])].push_back(u);
   return components;
 }
 

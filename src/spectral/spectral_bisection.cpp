@@ -17,10 +17,12 @@ double bestNcutThreshold(const WeightMatrix& W, const Eigen::VectorXd& y, int mi
   const int n = static_cast<int>(y.size());
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&y](int a, int b) { return y[a] > y[b]; });
+  // Largest first, ties in index order: the order a stable sort gives,
+  // without its buffer.
+  std::sort(order.begin(), order.end(), [&y](int a, int b) { return y[a] > y[b] || (y[a] == y[b] && a < b); });
   const Eigen::VectorXd d = degrees(W);
 
-  std::vector<bool> in_a(n, false);
+  std::vector<char> in_a(std::size_t(n), 0);
   double cut = 0.0, assoc_a = 0.0, assoc_b = d.sum();
   double best = std::numeric_limits<double>::infinity();
   double best_threshold = y.minCoeff() - 1.0;  // no valid cut: everything in A
