@@ -12,6 +12,7 @@
 #include <cctype>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <string>
 #include <cstring>
 
@@ -226,6 +227,73 @@ TEST(RecursivePartition, BoundaryRefinementMovesAnObservationToTheGroupItOverlap
   }
   options.boundary_passes = -1;
   EXPECT_THROW(recursivePartition(W, options), std::invalid_argument);
+}
+
+/// The boundary refinement by its definition: every sweep decides every
+/// observation from the previous sweep's groups (mean weight to each group,
+/// its own without it; ties stay, else the lower group), no minimum size.
+std::vector<int> refinedByDefinition(const WeightMatrix& W, std::vector<int> group_of, int groups, int passes) {
+  const int n = int(W.rows());
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<int> size(std::size_t(groups), 0);
+    for (int g : group_of) ++size[std::size_t(g)];
+    std::vector<int> next = group_of;
+    for (int i = 0; i < n; ++i) {
+      std::vector<double> sum(std::size_t(groups), 0.0);
+      for (WeightMatrix::InnerIterator it(W, i); it; ++it)
+        if (it.row() != i) sum[std::size_t(group_of[std::size_t(it.row())])] += it.value();
+      const int own = group_of[std::size_t(i)];
+      int best = own;
+      double best_mean = size[std::size_t(own)] > 1 ? sum[std::size_t(own)] / (size[std::size_t(own)] - 1) : 0.0;
+      for (int g = 0; g < groups; ++g)
+        if (g != own && sum[std::size_t(g)] > 0.0 && sum[std::size_t(g)] / size[std::size_t(g)] > best_mean)
+          best = g, best_mean = sum[std::size_t(g)] / size[std::size_t(g)];
+      next[std::size_t(i)] = best;
+    }
+    if (next == group_of) break;
+    group_of = std::move(next);
+  }
+  return group_of;
+}
+
+TEST(RecursivePartition, BoundaryRefinementEqualsItsDefinitionOnAnyThreadCount) {
+  // 120 rooms of 25 observations in a row (3,000: the sweeps run in blocks
+  // on every thread), each observation overlapping its own room, and some
+  // the next room more on average, so that observations move over several
+  // sweeps. The refinement, which visits again only the observations whose
+  // choice can change, must give what full sweeps give.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> weight(0.2, 1.0);
+  std::vector<WeightedPair> pairs;
+  const int rooms = 120, per_room = 25, n = rooms * per_room;
+  for (int r = 0; r < rooms; ++r)
+    for (int a = 0; a < per_room; ++a)
+      for (int b = a + 1; b < per_room; ++b)
+        if (weight(rng) > 0.5) pairs.push_back({r * per_room + a, r * per_room + b, weight(rng)});
+  for (int r = 0; r + 1 < rooms; ++r)
+    for (int a = per_room - 6; a < per_room; ++a)
+      for (int b = 0; b < 6; ++b) pairs.push_back({r * per_room + a, (r + 1) * per_room + b, 0.6 * weight(rng)});
+  const WeightMatrix W = buildWeightMatrix(n, pairs);
+  PartitionOptions options;
+  options.mutual_neighbours = 0;
+  options.boundary_passes = 0;
+  const Partition tree = recursivePartition(W, options);
+  ASSERT_GT(tree.groups.size(), 10u);
+  const std::vector<int> expected = refinedByDefinition(W, tree.group_of, int(tree.groups.size()), 3);
+  ASSERT_NE(expected, tree.group_of);  // observations do move
+  options.boundary_passes = 3;
+  for (int threads : {1, 2}) {
+    options.threads = threads;
+    const Partition refined = recursivePartition(W, options);
+    // The same membership; the groups are renumbered by their first member.
+    std::vector<std::vector<int>> by_definition(tree.groups.size());
+    for (int i = 0; i < n; ++i) by_definition[std::size_t(expected[std::size_t(i)])].push_back(i);
+    by_definition.erase(std::remove_if(by_definition.begin(), by_definition.end(),
+                                       [](const std::vector<int>& g) { return g.empty(); }),
+                        by_definition.end());
+    std::sort(by_definition.begin(), by_definition.end());
+    EXPECT_EQ(refined.groups, by_definition) << threads << " threads";
+  }
 }
 
 // The refinement keeps the minimum group size the tree guarantees.
