@@ -208,6 +208,8 @@ struct Configuration {
   /// GroupingParameters::mutual_neighbours (a count, swept as a number).
   double mutual_neighbours = GroupingParameters{}.mutual_neighbours;
   double mutual_neighbours_share = GroupingParameters{}.mutual_neighbours_share;
+  /// GroupingParameters::open_floor_width (the visibility model's alone).
+  double open_floor_width = GroupingParameters{}.open_floor_width;
   int threads = 0;  ///< 0: all cores
   /// Off: grouped at the poses given; Auto: at the poses the command groups
   /// at (each dataset's `corrected`).
@@ -224,7 +226,8 @@ struct Configuration {
     const auto same_method = [this](const GroupingParameters& p) {
       return model == p.model && split == p.split && ncut_threshold == p.ncut_threshold &&
              boundary_passes == p.boundary_passes && mutual_neighbours == p.mutual_neighbours &&
-             mutual_neighbours_share == p.mutual_neighbours_share;
+             mutual_neighbours_share == p.mutual_neighbours_share &&
+             (model != SensedSpaceModel::Visibility || open_floor_width == p.open_floor_width);
     };
     const bool paper = same_method(GroupingParameters::paper());
     const bool library_default = same_method(GroupingParameters{});
@@ -232,6 +235,9 @@ struct Configuration {
            (boundary_passes > 0 ? format(", %d boundary passes", boundary_passes) : std::string()) +
            (mutual_neighbours > 0 || mutual_neighbours_share > 0
                 ? format(", mutual neighbours %g / %g of the median", mutual_neighbours, mutual_neighbours_share)
+                : std::string()) +
+           (model == SensedSpaceModel::Visibility && open_floor_width > 0
+                ? format(", open floor %g m", open_floor_width)
                 : std::string()) +
            (correct_odometry == OdometryCorrection::Off && !paper ? ", poses as given" : "") +
            (paper ? " (the paper)" : "") +
@@ -242,11 +248,11 @@ struct Configuration {
   std::string parameters() const {
     return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
                   "door-width=%g door-depth=%g min-group-size=%d ncut-threshold=%g boundary-passes=%d "
-                  "mutual-neighbours=%g mutual-neighbours-share=%g correct-odometry=%s",
+                  "mutual-neighbours=%g mutual-neighbours-share=%g open-floor-width=%g correct-odometry=%s",
                   toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
                   region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
                   region.door_width, region.door_depth, min_group_size, ncut_threshold, boundary_passes,
-                  mutual_neighbours, mutual_neighbours_share, toString(correct_odometry).c_str());
+                  mutual_neighbours, mutual_neighbours_share, open_floor_width, toString(correct_odometry).c_str());
   }
 };
 
@@ -276,6 +282,7 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
     params.regions.max_range = c.region.max_range;
   } else {
     params.regions = c.region;
+    params.open_floor_width = c.open_floor_width;
   }
   params.split = c.split;
   params.min_group_size = c.min_group_size;
@@ -561,6 +568,7 @@ std::string sweepTable(const std::vector<Dataset>& datasets, const std::vector<L
       {"door depth (m)", [](Configuration& c) -> double& { return c.region.door_depth; }},
       {"mutual neighbours", [](Configuration& c) -> double& { return c.mutual_neighbours; }},
       {"mutual neighbours' share of the median", [](Configuration& c) -> double& { return c.mutual_neighbours_share; }},
+      {"open floor width (m)", [](Configuration& c) -> double& { return c.open_floor_width; }},
   };
   const SweepPoint reference = sweepPoint(datasets, logs, base);
   const auto change = [](int value, int of) {
@@ -701,13 +709,13 @@ int parseInteger(const std::string& flag, const std::string& text) {
 const char* kUsage =
     "usage: evaluate_grouping [--output FILE] [parameters] [selection]\n"
     "       evaluate_grouping --model M [--split S] [parameters] [selection]\n"
-    "Without --model: the page's fifteen configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's; the default without boundary refinement; the default with every overlap, no mutual neighbours; the default at the poses given, without the scan matching).\n"
+    "Without --model: the page's sixteen configurations (points, free-space, visibility; split mean and best; Ncut threshold 1 and the default's; the default without boundary refinement; the default without joins across open floor; the default with every overlap, no mutual neighbours; the default at the poses given, without the scan matching).\n"
     "With --model or --split: that one configuration (unset: the library's default), a line per dataset and a summary line.\n"
     "parameters (defaults: the library's):\n"
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --door-width M  --door-depth M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
-    "  --mutual-neighbours N  --mutual-neighbours-share X\n"
+    "  --mutual-neighbours N  --mutual-neighbours-share X  --open-floor-width M (visibility)\n"
     "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
     "  --correct-odometry auto|off (auto: at the poses the command groups at, scan-matched when more consistent)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
@@ -761,6 +769,7 @@ int main(int argc, char** argv) {
         {"--boundary-passes", integer(configuration.boundary_passes)},
         {"--mutual-neighbours", number(configuration.mutual_neighbours)},
         {"--mutual-neighbours-share", number(configuration.mutual_neighbours_share)},
+        {"--open-floor-width", number(configuration.open_floor_width)},
         {"--threads", integer(configuration.threads)},
         {"--voxel", number(configuration.voxel_leaf)},
         {"--correct-odometry",
@@ -895,6 +904,11 @@ int main(int argc, char** argv) {
   unrefined.ncut_threshold = defaults.ncut_threshold;
   unrefined.boundary_passes = 0;
   configurations.push_back(unrefined);
+  // The default without joins across open floor: what they change.
+  Configuration unjoined = unrefined;
+  unjoined.boundary_passes = defaults.boundary_passes;
+  unjoined.open_floor_width = 0;
+  configurations.push_back(unjoined);
   // The default on W itself, every overlap kept: what the mutual neighbours change.
   Configuration every_overlap = unrefined;
   every_overlap.boundary_passes = defaults.boundary_passes;

@@ -54,6 +54,7 @@ void GroupingParameters::usePaperMethod() {
   boundary_passes = papers.boundary_passes;
   mutual_neighbours = papers.mutual_neighbours;
   mutual_neighbours_share = papers.mutual_neighbours_share;
+  open_floor_width = 0.0;
 }
 
 void GroupingParameters::check() const {
@@ -91,6 +92,11 @@ void GroupingParameters::check() const {
   require(mutual_neighbours > 0 || mutual_neighbours_share == 0 ||
               mutual_neighbours_share == defaults.mutual_neighbours_share,
           "mutual_neighbours_share applies when mutual_neighbours is above 0");
+  require(std::isfinite(open_floor_width) && open_floor_width >= 0,
+          "open_floor_width must be finite and >= 0 (got " + number(open_floor_width) + ")");
+  require(model == SensedSpaceModel::Visibility || open_floor_width == 0 ||
+              open_floor_width == defaults.open_floor_width,
+          "open_floor_width applies to the visibility model, not " + model_name);
   require(min_group_size >= 1, "min_group_size must be >= 1 (got " + std::to_string(min_group_size) + ")");
   require(max_depth >= 0, "max_depth must be >= 0 (got " + std::to_string(max_depth) + ")");
   require(threads >= 0, "threads must be >= 0 (got " + std::to_string(threads) + ")");
@@ -115,7 +121,8 @@ bool operator==(const GroupingParameters& a, const GroupingParameters& b) {
          a.neighbour_search == b.neighbour_search && a.voxel_leaf == b.voxel_leaf &&
          a.diagonal_weight == b.diagonal_weight && a.split == b.split && a.ncut_threshold == b.ncut_threshold &&
          a.boundary_passes == b.boundary_passes && a.mutual_neighbours == b.mutual_neighbours &&
-         a.mutual_neighbours_share == b.mutual_neighbours_share && a.min_group_size == b.min_group_size &&
+         a.mutual_neighbours_share == b.mutual_neighbours_share && a.open_floor_width == b.open_floor_width &&
+         a.min_group_size == b.min_group_size &&
          a.max_depth == b.max_depth && a.eigen_solver == b.eigen_solver && a.threads == b.threads;
 }
 

@@ -193,6 +193,30 @@ TEST(OnlineGrouping, FewMutualNeighboursEqualBatchAfterEveryInsert) {
   EXPECT_NE(every_overlap.compute().groups, online.getPartition().groups);
 }
 
+TEST(OnlineGrouping, HallBandsJoinedAcrossOpenFloorAsInTheBatch) {
+  // The simulated hall is four times the regions' range: its bands are
+  // joined across open floor, by the batch and by every exact update.
+  const auto obs = test::simulate<pcl::PointXYZ>(sim::hallBuilding(), sim::hallBuildingRoute(160), sim::laser360());
+  ObservationGrouping<pcl::PointXYZ> batch;
+  for (const auto& o : obs) batch.addObservation(o.cloud, o.pose);
+  const Partition joined = batch.compute();
+  ASSERT_FALSE(batch.getOpenFloorJoins().empty());
+  GroupingParameters unjoined_params;
+  unjoined_params.open_floor_width = 0.0;
+  ObservationGrouping<pcl::PointXYZ> unjoined;
+  unjoined.setParameters(unjoined_params);
+  for (const auto& o : obs) unjoined.addObservation(o.cloud, o.pose);
+  EXPECT_GT(unjoined.compute().groups.size(), joined.groups.size());
+  EXPECT_TRUE(unjoined.getOpenFloorJoins().empty());
+  OnlineGrouping<pcl::PointXYZ> online;
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    online.insert(obs[k].cloud, obs[k].pose);
+    online.update();
+    if (k % 20 == 19 || k + 1 == obs.size()) expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "insert " + std::to_string(k));
+  }
+  EXPECT_EQ(online.getPartition().groups, joined.groups);
+}
+
 TEST(OnlineGrouping, ReportsChangesAndKeepsIdsOfUntouchedGroups) {
   const auto obs = driftedOffice();
   OnlineGrouping<pcl::PointXYZ> online;

@@ -61,6 +61,13 @@ struct GroupingParameters {
   /// paper's), and the share is not used.
   int mutual_neighbours = 60;
   double mutual_neighbours_share = 0.4;
+  /// Visibility model: two groups are joined when the route went from one to
+  /// the other only through open floor, where the free space is at least
+  /// this many metres across in every direction at every step between them
+  /// (joinAcrossOpenFloor): a hall or a large room that no view spans, cut
+  /// into bands, is one place again; doors and corridors are narrower.
+  /// 0: no joins (the paper's).
+  double open_floor_width = 4.5;
   /// A bisection giving a group smaller than this is rejected.
   int min_group_size = 1;
   /// Bisections deeper than this are not attempted.

@@ -7,6 +7,7 @@
 #include "obsgroup/cloud/observation.h"
 #include "obsgroup/grouping_parameters.h"
 #include "obsgroup/overlap/sensed_space_overlap.h"
+#include "obsgroup/partition/open_floor.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <functional>
@@ -181,6 +182,9 @@ class ObservationGrouping {
   /// in order: observations with no point (each forms a group of its own),
   /// then the partition's eigen-solver fallbacks (Partition::warnings).
   const std::vector<std::string>& getWarnings() const { return warnings_; }
+  /// The groups the last compute() joined across open floor
+  /// (GroupingParameters::open_floor_width), as indices of the groups before.
+  const std::vector<OpenFloorJoin>& getOpenFloorJoins() const { return open_floor_joins_; }
 
  private:
   std::vector<Observation<PointT>> observations_;
@@ -198,6 +202,7 @@ class ObservationGrouping {
   RegionsCallback regions_callback_;
   GroupingTimings timings_;
   std::vector<std::string> warnings_;
+  std::vector<OpenFloorJoin> open_floor_joins_;
 };
 
 }  // namespace obsgroup

@@ -9,6 +9,7 @@
 #include "obsgroup/observation_grouping.h"
 #include "obsgroup/overlap/incremental_overlap.h"
 #include "obsgroup/partition/group_tracking.h"
+#include "obsgroup/partition/open_floor.h"
 #include "obsgroup/partition/recursive_partitioner.h"
 
 #include <map>
@@ -155,6 +156,8 @@ class OnlineGrouping {
                                              const Eigen::Vector3d& origin) const;
   void recentreAll();
   std::vector<std::vector<int>> partitionExactly(const std::vector<int>& ids, GroupUpdate& out);
+  /// Joins partition_'s groups across open floor, as ObservationGrouping does.
+  void joinAcrossOpenFloor(const std::vector<int>& ids);
   GroupUpdate run(bool force_exact);
 
   std::vector<Slot> slots_;

@@ -75,7 +75,7 @@ _READER_OPTIONS = {
 _METHOD_OPTIONS = {
     "sso", "model", "paper", "cell", "range", "clearance", "min_observations", "band", "door_width", "door_depth",
     "delta", "voxel", "ncut_threshold", "boundary_passes", "mutual_neighbours", "mutual_neighbours_share", "split",
-    "min_group_size", "max_depth", "threads",
+    "open_floor_width", "min_group_size", "max_depth", "threads",
 }
 _COMMAND_OPTIONS = _READER_OPTIONS | _METHOD_OPTIONS | {
     "keyframes", "refine", "map_voxel", "force", "quiet", "no_pictures",
@@ -267,7 +267,7 @@ class Grouping:
     Keyword arguments are the command's method options: ``model=`` (``"visibility"``,
     ``"free-space"``, ``"points"``), ``cell=``, ``range=``, ``clearance=``, ``min_observations=``,
     ``band=(low, high)``, ``door_width=``, ``door_depth=``, ``delta=``, ``voxel=``, ``split=``, ``ncut_threshold=``,
-    ``boundary_passes=``, ``mutual_neighbours=``, ``mutual_neighbours_share=``, ``min_group_size=``,
+    ``boundary_passes=``, ``mutual_neighbours=``, ``mutual_neighbours_share=``, ``open_floor_width=``, ``min_group_size=``,
     ``max_depth=``, ``paper=True``, ``threads=``.
     Their defaults are the command's; a bad value raises :class:`UsageError`.
     """

@@ -674,6 +674,7 @@ PYBIND11_MODULE(_obsgroup, m) {
         d["boundary_passes"] = p.boundary_passes;
         d["mutual_neighbours"] = p.mutual_neighbours;
         d["mutual_neighbours_share"] = p.mutual_neighbours_share;
+        d["open_floor_width"] = p.open_floor_width;
         d["threads"] = p.threads;
         return d;
       });

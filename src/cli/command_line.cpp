@@ -194,7 +194,8 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
                    "the paper's method exactly: --sso " + toString(paper.model) + " --split " + toString(paper.split) +
                        " --ncut-threshold " + number(paper.ncut_threshold) + " --boundary-passes " +
                        std::to_string(paper.boundary_passes) + " --mutual-neighbours " +
-                       std::to_string(paper.mutual_neighbours) + " --correct-odometry off (delta as given)")
+                       std::to_string(paper.mutual_neighbours) + " --open-floor-width " +
+                       number(paper.open_floor_width) + " --correct-odometry off (delta as given)")
       ->group("Sensed-space model");
   command.add_option("--cell", args.method.regions.cell_size, "free-space, visibility: grid cell (voxel in 3D), metres")
       ->check(finiteNumber(0.0, true))
@@ -260,6 +261,13 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
   command.add_option("--mutual-neighbours-share", args.method.mutual_neighbours_share,
                      "... or this share of the median number of observations each overlaps, when more")
       ->check(finiteNumber(0.0, false, 10.0))
+      ->capture_default_str()
+      ->group("Partition");
+  command.add_option("--open-floor-width", args.method.open_floor_width,
+                     "join two groups when every step of the route between them passes through enclosed floor at "
+                     "least this wide, metres (a hall or a large room no view spans, cut into bands; 0: none, the "
+                     "paper's)")
+      ->check(finiteNumber(0.0, false, 1000.0))
       ->capture_default_str()
       ->group("Partition");
   command.add_option("--split", args.method.split,
@@ -512,6 +520,8 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
     for (const char* option : {"--mutual-neighbours", "--mutual-neighbours-share"})
       if (partition.count(option))
         return std::string("--paper uses every overlap (--mutual-neighbours 0); drop ") + option;
+    if (partition.count("--open-floor-width") && args.method.open_floor_width != 0.0)
+      return "--paper joins no groups (--open-floor-width 0); drop one of them";
     if (partition.count("--correct-odometry") && args.correct_odometry != obsgroup::OdometryCorrection::Off)
       return "--paper groups at the input poses (--correct-odometry off); drop one of them";
     args.method.usePaperMethod();
@@ -526,7 +536,8 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
       return std::string(option) + " applies to --sso free-space or visibility, not points";
   if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
   if (args.method.model != SensedSpaceModel::Visibility)
-    for (const char* option : {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth"})
+    for (const char* option :
+         {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth", "--open-floor-width"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
   if (args.voxel) args.method.voxel_leaf = *args.voxel;
   if (!args.band.empty()) {

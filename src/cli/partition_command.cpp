@@ -226,7 +226,8 @@ void groupObservations(const PartitionArgs& args, const std::vector<Observation<
   // matched on its own); a user counts a pair once.
   out.statistics = {{"pairs_evaluated", overlap.pairs_evaluated / 2},
                     {"point_tests", overlap.point_tests},
-                    {"edges", edgeCount(out.weights())}};
+                    {"edges", edgeCount(out.weights())},
+                    {"open_floor_joins", grouping.getOpenFloorJoins().size()}};
   const auto& t = grouping.getTimings();
   out.timing_s = {{"overlap", t.overlap_s}, {"graph", t.graph_s}, {"partition", t.partition_s}};
 }
@@ -333,6 +334,7 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
       p["band"] = {method.regions.band_low, method.regions.band_high};
       p["door_width"] = method.regions.door_width;
       p["door_depth"] = method.regions.door_depth;
+      p["open_floor_width"] = method.open_floor_width;
     }
   }
   p["voxel"] = method.voxel_leaf;

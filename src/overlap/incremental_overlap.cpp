@@ -490,6 +490,12 @@ std::size_t IncrementalOverlap::pointCount(int slot) const {
 std::size_t IncrementalOverlap::regionCells(int slot) const {
   return state_->present(slot) ? state_->slots[slot].region.size() : 0;
 }
+bool IncrementalOverlap::occupiedPlaneCell(const Eigen::Vector2d& p) const {
+  if (state_->model != SensedSpaceModel::Visibility) return false;
+  OccupancyGrid::Reader reader(state_->occupancy);
+  return reader.occupied(cellOf<2>(state_->grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
+}
+
 std::size_t IncrementalOverlap::recomputedLastUpdate() const { return state_->recomputed; }
 
 WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const { return weightMatrix(diagonal, nullptr); }

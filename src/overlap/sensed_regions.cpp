@@ -222,7 +222,8 @@ std::uint64_t ObservationRegions::firstKey() const { return run_start_.empty() ?
 
 bool ObservationRegions::operator==(const ObservationRegions& other) const {
   return planar == other.planar && cell_size == other.cell_size && phase == other.phase &&
-         run_start_ == other.run_start_ && run_length_ == other.run_length_ && run_offsets_ == other.run_offsets_;
+         run_start_ == other.run_start_ && run_length_ == other.run_length_ && run_offsets_ == other.run_offsets_ &&
+         occupied == other.occupied;
 }
 
 namespace {
@@ -232,6 +233,7 @@ namespace {
 /// (8 bytes a cell) are never all held at once.
 struct RegionLists {
   std::vector<RunList> cells;
+  std::vector<std::uint64_t> occupied;  // visibility: plane cell keys, ascending
   bool planar = true;
   double cell_size = 1.0;
   Eigen::Vector3d phase = Eigen::Vector3d::Constant(0.5);
@@ -257,8 +259,9 @@ RegionLists regionLists(SensedSpaceModel model, const WorldPoints& world,
   for (int a = 0; a < 3; ++a) regions.phase[a] = cells.phase[a];
   const bool volumetric = model == SensedSpaceModel::FreeSpace && !regions.planar;
   checkReach(world, sensor_origins, params, volumetric);
-  std::vector<std::uint64_t> occupied;
+  std::vector<std::uint64_t>& occupied = regions.occupied;
   if (model == SensedSpaceModel::Visibility) occupied = occupiedCells(world, sensor_origins, params, cells, regions.planar, threads);
+  std::sort(occupied.begin(), occupied.end());
   const OccupancyGrid grid(occupied);
   std::vector<RunList>& per_observation = regions.cells;
   per_observation.resize(n);
@@ -474,6 +477,7 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
   regions.planar = lists.planar;
   regions.cell_size = lists.cell_size;
   regions.phase = lists.phase;
+  regions.occupied = std::move(lists.occupied);
   // The lists are handed back as they are copied, so that the regions are
   // not resident twice at the end.
   std::size_t freed = 0;
@@ -497,6 +501,7 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
   std::vector<std::size_t> sizes(lists.cells.size());
   for (std::size_t i = 0; i < sizes.size(); ++i) sizes[i] = lists.cells[i].cells;
   OverlapResult result = assembleOverlap(countShared(lists, threadCount(threads), interrupt), sizes);
+  result.occupied_cells = std::move(lists.occupied);
   returnFreedMemory(kTrimBytes);  // the rows of counts, a small list per observation
   return result;
 }
@@ -513,8 +518,15 @@ OverlapResult regionOverlap(const ObservationRegions& regions, int threads, cons
   std::vector<std::size_t> sizes(regions.size());
   for (int i = 0; i < regions.size(); ++i) sizes[i] = regions.count(i);
   OverlapResult result = assembleOverlap(countSharedCells(regions, threads, interrupt), sizes);
+  result.occupied_cells = regions.occupied;
   returnFreedMemory(kTrimBytes);  // the rows of counts, a small list per observation
   return result;
+}
+
+bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p) {
+  const CellGrid grid(cell_size);
+  const std::uint64_t key = keyOf<2>(cellOf<2>(grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
+  return std::binary_search(occupied.begin(), occupied.end(), key);
 }
 
 }  // namespace obsgroup

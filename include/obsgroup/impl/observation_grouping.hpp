@@ -4,6 +4,7 @@
 #include "obsgroup/observation_grouping.h"
 
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -27,6 +28,7 @@ void ObservationGrouping<PointT>::clear() {
   W_ = WeightMatrix{};
   world_ = WorldPoints{};
   warnings_.clear();
+  open_floor_joins_.clear();
 }
 
 template <typename PointT>
@@ -71,6 +73,22 @@ Partition ObservationGrouping<PointT>::compute() {
   timings_.graph_s = seconds_since(start);
   start = Clock::now();
   Partition partition = recursivePartition(W_, getPartitionOptions());
+  open_floor_joins_.clear();
+  if (params_.model == SensedSpaceModel::Visibility && params_.open_floor_width > 0.0 && !observations_.empty()) {
+    // In the re-centred frame the regions were cast in (SensedSpaceOverlap::compute).
+    const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations_);
+    std::vector<Eigen::Vector2d> positions(observations_.size());
+    for (std::size_t i = 0; i < observations_.size(); ++i)
+      positions[i] = overlap_result_.points_per_observation[i] == 0
+                         ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
+                         : Eigen::Vector2d((observations_[i].pose.translation() - origin).template head<2>());
+    const std::vector<std::uint64_t>& occupied = overlap_result_.occupied_cells;
+    const double cell = params_.regions.cell_size;
+    open_floor_joins_ = joinAcrossOpenFloor(partition, positions, params_.open_floor_width, cell,
+                                            [&](const Eigen::Vector2d& p) { return occupiedPlaneCell(occupied, cell, p); },
+                                            params_.regions.max_range);
+  }
+  std::vector<std::uint64_t>().swap(overlap_result_.occupied_cells);  // read by the joins alone
   timings_.partition_s = seconds_since(start);
 
   warnings_.clear();

@@ -6,6 +6,7 @@
 #include "obsgroup/overlap/impl/sensed_space_overlap.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -188,6 +189,7 @@ GroupUpdate OnlineGrouping<PointT>::run(bool force_exact) {
     groups = partitionExactly(ids, out);
   } else {
     partition_ = partitionAroundChanges(W_, ids, moved_, group_ids_, getPartitionOptions());
+    joinAcrossOpenFloor(ids);
     for (const auto& group : partition_.groups) {
       std::vector<int> members;
       for (int k : group) members.push_back(ids[k]);
@@ -215,6 +217,7 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std
   // Only the nodes holding a source are solved again: a new observation
   // changes its neighbours' rows, not the blocks of the nodes without it.
   partition_ = recursivePartition(W_, getPartitionOptions(), ids, changed, sources, cache_);
+  joinAcrossOpenFloor(ids);
   out.split_nodes_reused = cache_.reusedNodes();
   out.split_nodes_computed = cache_.computedNodes();
   out.split_nodes_ahead = cache_.aheadNodes();
@@ -229,6 +232,21 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std
     groups.push_back(std::move(members));
   }
   return groups;
+}
+
+template <typename PointT>
+void OnlineGrouping<PointT>::joinAcrossOpenFloor(const std::vector<int>& ids) {
+  if (params_.model != SensedSpaceModel::Visibility || !(params_.open_floor_width > 0.0) || ids.empty()) return;
+  // In the re-centred frame the regions are cast in, as the batch's.
+  std::vector<Eigen::Vector2d> positions(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    positions[k] = overlap_->pointCount(ids[k]) == 0
+                       ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
+                       : Eigen::Vector2d((slots_[std::size_t(ids[k])].observation.pose.translation() - origin_).template head<2>());
+  const IncrementalOverlap& overlap = *overlap_;
+  obsgroup::joinAcrossOpenFloor(partition_, positions, params_.open_floor_width, params_.regions.cell_size,
+                                [&overlap](const Eigen::Vector2d& p) { return overlap.occupiedPlaneCell(p); },
+                                params_.regions.max_range);
 }
 
 template <typename PointT>

@@ -81,6 +81,12 @@ class IncrementalOverlap {
   /// region models.
   std::size_t pointCount(int slot) const;
   std::size_t regionCells(int slot) const;
+  /// Visibility: whether the plane cell holding p (x and y in the re-centred
+  /// frame) is occupied in the evidence of the observations present, as of
+  /// the last update(): the cells SensedSpaceOverlap::compute gives in
+  /// OverlapResult::occupied_cells for the same observations. False for the
+  /// other models.
+  bool occupiedPlaneCell(const Eigen::Vector2d& p) const;
   /// Observations whose region was recomputed by the last update() (the
   /// changed ones and, for visibility, those whose view a change reached).
   std::size_t recomputedLastUpdate() const;

@@ -113,6 +113,10 @@ class ObservationRegions {
   /// Where the cells lie: a cell's corner is at (k - phase) * cell_size in
   /// the re-centred frame of the WorldPoints (the first sensor at a centre).
   Eigen::Vector3d phase = Eigen::Vector3d::Constant(0.5);
+  /// Visibility: the plane cells occupied in the evidence of all
+  /// observations (keys ascending; occupiedPlaneCell reads them); empty for
+  /// free space.
+  std::vector<std::uint64_t> occupied;
 
   /// Adds the next observation's region: keys ascending and distinct (else
   /// std::invalid_argument, naming the observation).
@@ -185,6 +189,12 @@ ObservationRegions computeRegions(SensedSpaceModel model, const WorldPoints& wor
 OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& world,
                                    const std::vector<Eigen::Vector3d>& sensor_origins, const RegionParameters& params,
                                    int threads = 0, const InterruptFlag* interrupt = nullptr);
+
+/// Whether the plane cell of `cell_size` metres holding p (x and y in the
+/// re-centred frame of the world points) is one of `occupied` (plane cell
+/// keys ascending, as ObservationRegions::occupied and
+/// OverlapResult::occupied_cells hold them).
+bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p);
 
 /// For every observation i and every j != i, the number of cells of i's
 /// region that j's region holds (the numerator of Pi).
