@@ -3,6 +3,7 @@
 // camera of 160 x 120 points), generated in memory.
 //
 //   online_latency 2d|3d N [--sample K] [--update-every U] [--exact-every E] [--check C] [--threads T]
+//                  [--open-floor-width M]
 //
 // Without --sample, every observation is inserted and timed (a full replay),
 // and the batch ObservationGrouping::compute() on the same N is timed too.
@@ -80,12 +81,14 @@ double percentile(std::vector<double> v, double q) {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: online_latency 2d|3d N [--sample K] [--update-every U] [--threads T]\n");
+    std::fprintf(stderr,
+                 "usage: online_latency 2d|3d N [--sample K] [--update-every U] [--threads T] [--open-floor-width M]\n");
     return 2;
   }
   const std::string kind = argv[1];
   const int n = std::atoi(argv[2]);
   int sample = 0, every = 1, threads = 0, exact_every = 1, check = 0;
+  double open_floor_width = GroupingParameters{}.open_floor_width;
   for (int a = 3; a + 1 < argc; a += 2) {
     const std::string option = argv[a];
     if (option == "--sample") sample = std::atoi(argv[a + 1]);
@@ -93,6 +96,7 @@ int main(int argc, char** argv) {
     else if (option == "--threads") threads = std::atoi(argv[a + 1]);
     else if (option == "--exact-every") exact_every = std::atoi(argv[a + 1]);
     else if (option == "--check") check = std::atoi(argv[a + 1]);
+    else if (option == "--open-floor-width") open_floor_width = std::atof(argv[a + 1]);
   }
   if ((kind != "2d" && kind != "3d") || n < 2 || sample < 0 || sample >= n) {
     std::fprintf(stderr, "online_latency: bad arguments\n");
@@ -101,6 +105,9 @@ int main(int argc, char** argv) {
   const auto input = makeInput(kind, n);
 
   OnlineGrouping<pcl::PointXYZ> online;
+  GroupingParameters params;
+  params.open_floor_width = open_floor_width;
+  online.setParameters(params);
   online.setNumberOfThreads(threads);
   online.setExactInterval(exact_every);
   const int untimed = sample > 0 ? n - sample : 0;
@@ -123,6 +130,7 @@ int main(int argc, char** argv) {
     if (check > 0 && (k + 1) % check == 0 && k + 1 < n) {
       const auto check_start = Clock::now();
       ObservationGrouping<pcl::PointXYZ> reference;
+      reference.setParameters(params);
       reference.setNumberOfThreads(threads);
       for (int i = 0; i <= k; ++i) reference.addObservation(input[i].cloud, input[i].pose);
       lowest_ari = std::min(lowest_ari, sim::adjustedRandIndex(reference.compute().group_of,
@@ -134,6 +142,7 @@ int main(int argc, char** argv) {
 
   double batch_s = 0.0;
   ObservationGrouping<pcl::PointXYZ> batch;
+  batch.setParameters(params);
   batch.setNumberOfThreads(threads);
   for (const auto& o : input) batch.addObservation(o.cloud, o.pose);
   const auto batch_start = Clock::now();

@@ -490,6 +490,15 @@ std::size_t IncrementalOverlap::pointCount(int slot) const {
 std::size_t IncrementalOverlap::regionCells(int slot) const {
   return state_->present(slot) ? state_->slots[slot].region.size() : 0;
 }
+std::function<bool(const Eigen::Vector2d&)> IncrementalOverlap::planeCellReader() const {
+  if (state_->model != SensedSpaceModel::Visibility) return [](const Eigen::Vector2d&) { return false; };
+  auto reader = std::make_shared<OccupancyGrid::Reader>(state_->occupancy);
+  const CellGrid grid = state_->grid;
+  return [reader, grid](const Eigen::Vector2d& p) {
+    return reader->occupied(cellOf<2>(grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
+  };
+}
+
 bool IncrementalOverlap::occupiedPlaneCell(const Eigen::Vector2d& p) const {
   if (state_->model != SensedSpaceModel::Visibility) return false;
   OccupancyGrid::Reader reader(state_->occupancy);

@@ -49,6 +49,33 @@ struct UnionFind {
 
 }  // namespace
 
+namespace {
+
+/// narrowestChord, stopped as soon as a chord is found narrower than
+/// `at_least` (then some chord below it is returned): a step through a
+/// door or a corridor is settled by its first narrow line.
+double narrowestChordUntil(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
+                           double at_least, const OccupiedAt& occupied) {
+  const double length = (b - a).norm();
+  const int intervals = std::max(1, int(std::ceil(length / cell)));
+  double narrowest = 2.0 * cap;
+  for (int s = 0; s <= intervals; ++s) {
+    const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
+    for (int line = 0; line < kLines; ++line) {
+      const double angle = 3.14159265358979323846 * double(line) / double(kLines);
+      const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+      const double ahead = freeRun(p, direction, 0.5 * cell, cap, occupied);
+      // The side behind need not be walked beyond what would reach at_least.
+      const double behind = freeRun(p, -direction, 0.5 * cell, std::min(cap, std::max(at_least - ahead, 0.0) + cell), occupied);
+      narrowest = std::min(narrowest, ahead + behind);
+      if (narrowest < at_least) return narrowest;
+    }
+  }
+  return narrowest;
+}
+
+}  // namespace
+
 double narrowestChord(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
                       const OccupiedAt& occupied) {
   const double length = (b - a).norm();
@@ -147,7 +174,9 @@ std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::
     const Eigen::Vector2d &from = positions[std::size_t(k)], &to = positions[std::size_t(k + 1)];
     double chord = 0.0;  // a step from or to an observation without a position is no evidence
     if (from.allFinite() && to.allFinite()) {
-      chord = narrowestChord(from, to, cell, width, occupied);
+      chord = narrowestChordUntil(from, to, cell, width, width, occupied);
+      // Open floor (rare): walk every line in full, for the join's record.
+      if (chord >= width) chord = narrowestChord(from, to, cell, width, occupied);
       if (chord >= width && !enclosedAlong(from, to, cell, reach, occupied, seen)) chord = 0.0;
     }
     if (it == narrowest.end())

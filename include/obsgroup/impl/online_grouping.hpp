@@ -243,10 +243,8 @@ void OnlineGrouping<PointT>::joinAcrossOpenFloor(const std::vector<int>& ids) {
     positions[k] = overlap_->pointCount(ids[k]) == 0
                        ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
                        : Eigen::Vector2d((slots_[std::size_t(ids[k])].observation.pose.translation() - origin_).template head<2>());
-  const IncrementalOverlap& overlap = *overlap_;
   obsgroup::joinAcrossOpenFloor(partition_, positions, params_.open_floor_width, params_.regions.cell_size,
-                                [&overlap](const Eigen::Vector2d& p) { return overlap.occupiedPlaneCell(p); },
-                                params_.regions.max_range);
+                                overlap_->planeCellReader(), params_.regions.max_range);
 }
 
 template <typename PointT>

@@ -10,6 +10,7 @@
 #include "obsgroup/overlap/sensed_regions.h"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -87,6 +88,10 @@ class IncrementalOverlap {
   /// OverlapResult::occupied_cells for the same observations. False for the
   /// other models.
   bool occupiedPlaneCell(const Eigen::Vector2d& p) const;
+  /// The same as a function that remembers the tile it read last (walks
+  /// along a line read the same tile again and again): for one caller at a
+  /// time, until the next change.
+  std::function<bool(const Eigen::Vector2d&)> planeCellReader() const;
   /// Observations whose region was recomputed by the last update() (the
   /// changed ones and, for visibility, those whose view a change reached).
   std::size_t recomputedLastUpdate() const;
