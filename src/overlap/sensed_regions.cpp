@@ -523,6 +523,20 @@ OverlapResult regionOverlap(const ObservationRegions& regions, int threads, cons
   return result;
 }
 
+std::function<bool(const Eigen::Vector2d&)> planeCellReader(const std::vector<std::uint64_t>& occupied,
+                                                            double cell_size) {
+  struct Bitmap {
+    explicit Bitmap(const std::vector<std::uint64_t>& keys) : grid(keys), reader(grid) {}
+    OccupancyGrid grid;
+    OccupancyGrid::Reader reader;
+  };
+  auto bitmap = std::make_shared<Bitmap>(occupied);
+  const CellGrid grid(cell_size);
+  return [bitmap, grid](const Eigen::Vector2d& p) {
+    return bitmap->reader.occupied(cellOf<2>(grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
+  };
+}
+
 bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p) {
   const CellGrid grid(cell_size);
   const std::uint64_t key = keyOf<2>(cellOf<2>(grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));

@@ -82,10 +82,9 @@ Partition ObservationGrouping<PointT>::compute() {
       positions[i] = overlap_result_.points_per_observation[i] == 0
                          ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
                          : Eigen::Vector2d((observations_[i].pose.translation() - origin).template head<2>());
-    const std::vector<std::uint64_t>& occupied = overlap_result_.occupied_cells;
     const double cell = params_.regions.cell_size;
     open_floor_joins_ = joinAcrossOpenFloor(partition, positions, params_.open_floor_width, cell,
-                                            [&](const Eigen::Vector2d& p) { return occupiedPlaneCell(occupied, cell, p); },
+                                            planeCellReader(overlap_result_.occupied_cells, cell),
                                             params_.regions.max_range);
   }
   std::vector<std::uint64_t>().swap(overlap_result_.occupied_cells);  // read by the joins alone

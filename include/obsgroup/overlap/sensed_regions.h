@@ -23,6 +23,7 @@
 #include "obsgroup/overlap/world_points.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -195,6 +196,10 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
 /// keys ascending, as ObservationRegions::occupied and
 /// OverlapResult::occupied_cells hold them).
 bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p);
+/// The same as a function over a bitmap of the cells made once, which
+/// remembers the tile it read last: for many reads by one caller.
+std::function<bool(const Eigen::Vector2d&)> planeCellReader(const std::vector<std::uint64_t>& occupied,
+                                                            double cell_size);
 
 /// For every observation i and every j != i, the number of cells of i's
 /// region that j's region holds (the numerator of Pi).
