@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <unordered_map>
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 namespace obsgroup {
@@ -47,17 +47,14 @@ struct UnionFind {
   std::vector<int> parent;
 };
 
-}  // namespace
-
-namespace {
-
-/// narrowestChord, stopped as soon as a chord is found narrower than
-/// `at_least` (then some chord below it is returned): a step through a
-/// door or a corridor is settled by its first narrow line.
-double narrowestChordUntil(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
-                           double at_least, const OccupiedAt& occupied) {
-  const double length = (b - a).norm();
-  const int intervals = std::max(1, int(std::ceil(length / cell)));
+/// The chords through the points of the segment, as narrowestChord walks
+/// them, stopped as soon as one is narrower than `stop_below` (when above 0;
+/// a chord below it is then returned): a step through a door or a corridor
+/// is settled by its first narrow line, whose far side need not be walked
+/// beyond what would reach `stop_below`.
+double walkChords(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap, double stop_below,
+                  const OccupiedAt& occupied) {
+  const int intervals = std::max(1, int(std::ceil((b - a).norm() / cell)));
   double narrowest = 2.0 * cap;
   for (int s = 0; s <= intervals; ++s) {
     const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
@@ -65,56 +62,13 @@ double narrowestChordUntil(const Eigen::Vector2d& a, const Eigen::Vector2d& b, d
       const double angle = 3.14159265358979323846 * double(line) / double(kLines);
       const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
       const double ahead = freeRun(p, direction, 0.5 * cell, cap, occupied);
-      // The side behind need not be walked beyond what would reach at_least.
-      const double behind = freeRun(p, -direction, 0.5 * cell, std::min(cap, std::max(at_least - ahead, 0.0) + cell), occupied);
-      narrowest = std::min(narrowest, ahead + behind);
-      if (narrowest < at_least) return narrowest;
+      const double behind_cap = stop_below > 0.0 ? std::min(cap, std::max(stop_below - ahead, 0.0) + cell) : cap;
+      narrowest = std::min(narrowest, ahead + freeRun(p, -direction, 0.5 * cell, behind_cap, occupied));
+      if (narrowest == 0.0 || narrowest < stop_below) return narrowest;
     }
   }
   return narrowest;
 }
-
-}  // namespace
-
-double narrowestChord(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
-                      const OccupiedAt& occupied) {
-  const double length = (b - a).norm();
-  const int intervals = std::max(1, int(std::ceil(length / cell)));
-  double narrowest = 2.0 * cap;
-  for (int s = 0; s <= intervals; ++s) {
-    const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
-    for (int line = 0; line < kLines; ++line) {
-      const double angle = 3.14159265358979323846 * double(line) / double(kLines);
-      const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
-      const double chord = freeRun(p, direction, 0.5 * cell, cap, occupied) +
-                           freeRun(p, -direction, 0.5 * cell, cap, occupied);
-      narrowest = std::min(narrowest, chord);
-      if (narrowest == 0.0) return 0.0;
-    }
-  }
-  return narrowest;
-}
-
-bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double reach,
-                   const OccupiedAt& occupied, const SeenAt& seen) {
-  const int intervals = std::max(1, int(std::ceil((b - a).norm() / cell)));
-  const double step = 0.5 * cell;
-  for (int s = 0; s <= intervals; ++s) {
-    const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
-    for (int direction = 0; direction < 2 * kLines; ++direction) {
-      const double angle = 3.14159265358979323846 * double(direction) / double(kLines);
-      const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
-      // The first occupied cell along the ray must be a wall the route came
-      // near, not a structure far off that no view reached.
-      double t = 0.0;
-      while (t < reach && !occupied(p + t * d)) t += step;
-      if (t >= reach || !seen(p + t * d)) return false;
-    }
-  }
-  return true;
-}
-
-namespace {
 
 /// The observations' positions by square cells of `range`: whether a point
 /// lies within `range` of one looks at the nine cells around it.
@@ -147,6 +101,30 @@ class NearPositions {
 
 }  // namespace
 
+double narrowestChord(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
+                      const OccupiedAt& occupied) {
+  return walkChords(a, b, cell, cap, 0.0, occupied);
+}
+
+bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double reach,
+                   const OccupiedAt& occupied, const SeenAt& seen) {
+  const int intervals = std::max(1, int(std::ceil((b - a).norm() / cell)));
+  const double step = 0.5 * cell;
+  for (int s = 0; s <= intervals; ++s) {
+    const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
+    for (int direction = 0; direction < 2 * kLines; ++direction) {
+      const double angle = 3.14159265358979323846 * double(direction) / double(kLines);
+      const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
+      // The first occupied cell along the ray must be a wall the route came
+      // near, not a structure far off that no view reached.
+      double t = 0.0;
+      while (t < reach && !occupied(p + t * d)) t += step;
+      if (t >= reach || !seen(p + t * d)) return false;
+    }
+  }
+  return true;
+}
+
 std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::vector<Eigen::Vector2d>& positions,
                                                double width, double cell, const OccupiedAt& occupied,
                                                double view_range, double reach) {
@@ -174,7 +152,7 @@ std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::
     const Eigen::Vector2d &from = positions[std::size_t(k)], &to = positions[std::size_t(k + 1)];
     double chord = 0.0;  // a step from or to an observation without a position is no evidence
     if (from.allFinite() && to.allFinite()) {
-      chord = narrowestChordUntil(from, to, cell, width, width, occupied);
+      chord = walkChords(from, to, cell, width, width, occupied);
       // Open floor (rare): walk every line in full, for the join's record.
       if (chord >= width) chord = narrowestChord(from, to, cell, width, occupied);
       if (chord >= width && !enclosedAlong(from, to, cell, reach, occupied, seen)) chord = 0.0;
