@@ -82,7 +82,8 @@ double percentile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   if (argc < 3) {
     std::fprintf(stderr,
-                 "usage: online_latency 2d|3d N [--sample K] [--update-every U] [--threads T] [--open-floor-width M]\n");
+                 "usage: online_latency 2d|3d N [--sample K] [--update-every U] [--threads T]"
+                 " [--open-floor-width M]\n");
     return 2;
   }
   const std::string kind = argv[1];

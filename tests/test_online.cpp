@@ -212,7 +212,8 @@ TEST(OnlineGrouping, HallBandsJoinedAcrossOpenFloorAsInTheBatch) {
   for (std::size_t k = 0; k < obs.size(); ++k) {
     online.insert(obs[k].cloud, obs[k].pose);
     online.update();
-    if (k % 20 == 19 || k + 1 == obs.size()) expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "insert " + std::to_string(k));
+    if (k % 20 == 19 || k + 1 == obs.size())
+      expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "insert " + std::to_string(k));
   }
   EXPECT_EQ(online.getPartition().groups, joined.groups);
 }

@@ -30,7 +30,10 @@ class Walls {
   }
   /// The outline of the box [x0, x1] x [y0, y1].
   Walls& box(double x0, double y0, double x1, double y1) {
-    return segment({x0, y0}, {x1, y0}).segment({x1, y0}, {x1, y1}).segment({x1, y1}, {x0, y1}).segment({x0, y1}, {x0, y0});
+    return segment({x0, y0}, {x1, y0})
+        .segment({x1, y0}, {x1, y1})
+        .segment({x1, y1}, {x0, y1})
+        .segment({x0, y1}, {x0, y0});
   }
   OccupiedAt occupied() const {
     return [this](const Eigen::Vector2d& p) { return cells_.count(cellOf(p)) > 0; };
@@ -93,7 +96,9 @@ TEST(OpenFloor, TheNarrowestChordIsTheFreeSpaceAcross) {
 
 TEST(OpenFloor, EnclosedByWallsTheRouteCameNear) {
   const Walls walls = hallAndRoom();
-  const SeenAt near_route = [](const Eigen::Vector2d& p) { return p.x() >= -7 && p.x() <= 29 && std::abs(p.y() - 5) <= 8; };
+  const SeenAt near_route = [](const Eigen::Vector2d& p) {
+    return p.x() >= -7 && p.x() <= 29 && std::abs(p.y() - 5) <= 8;
+  };
   EXPECT_TRUE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, walls.occupied(), near_route));
   // Walls farther than the reach do not enclose, nor walls no view came near.
   EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 10.0, walls.occupied(), near_route));
@@ -107,7 +112,8 @@ TEST(OpenFloor, EnclosedByWallsTheRouteCameNear) {
 TEST(OpenFloor, BandsOfAHallAreJoinedAndTheRoomBehindItsDoorIsNot) {
   const Walls walls = hallAndRoom();
   Route r = alongTheMiddle();
-  const std::vector<OpenFloorJoin> joins = joinAcrossOpenFloor(r.partition, r.positions, 4.5, kCell, walls.occupied(), 6.0);
+  const std::vector<OpenFloorJoin> joins =
+      joinAcrossOpenFloor(r.partition, r.positions, 4.5, kCell, walls.occupied(), 6.0);
   ASSERT_EQ(joins.size(), 1u);
   EXPECT_EQ(joins[0].first, 0);
   EXPECT_EQ(joins[0].second, 1);

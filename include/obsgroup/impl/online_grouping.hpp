@@ -239,10 +239,12 @@ void OnlineGrouping<PointT>::joinAcrossOpenFloor(const std::vector<int>& ids) {
   if (params_.model != SensedSpaceModel::Visibility || !(params_.open_floor_width > 0.0) || ids.empty()) return;
   // In the re-centred frame the regions are cast in, as the batch's.
   std::vector<Eigen::Vector2d> positions(ids.size());
-  for (std::size_t k = 0; k < ids.size(); ++k)
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const Eigen::Vector3d& at = slots_[std::size_t(ids[k])].observation.pose.translation();
     positions[k] = overlap_->pointCount(ids[k]) == 0
                        ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
-                       : Eigen::Vector2d((slots_[std::size_t(ids[k])].observation.pose.translation() - origin_).template head<2>());
+                       : Eigen::Vector2d((at - origin_).template head<2>());
+  }
   obsgroup::joinAcrossOpenFloor(partition_, positions, params_.open_floor_width, params_.regions.cell_size,
                                 overlap_->planeCellReader(), params_.regions.max_range);
 }
