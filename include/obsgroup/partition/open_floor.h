@@ -55,9 +55,9 @@ bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double ce
 /// (enclosedAlong): a hall up to about 30 m across.
 constexpr double kOpenFloorReach = 30.0;
 /// A wall encloses when it lies within this many times a view's range of an
-/// observation: a route along the walls of a room 17 m wide leaves parts of
-/// them 6-7 m off; the structures round a building outdoors lie farther
-/// (docs/method.md, "Open floor").
+/// observation: with walls within 6 m, a route along the walls of a room of
+/// about 11 x 25 m left it unjoined on one run of three; the structures
+/// round a building outdoors lie farther (docs/method.md, "Open floor").
 constexpr double kSeenBeyondViews = 4.0 / 3.0;
 
 /// Joins the groups of `partition` between which every step of the route
