@@ -499,11 +499,6 @@ std::function<bool(const Eigen::Vector2d&)> IncrementalOverlap::planeCellReader(
   };
 }
 
-bool IncrementalOverlap::occupiedPlaneCell(const Eigen::Vector2d& p) const {
-  if (state_->model != SensedSpaceModel::Visibility) return false;
-  OccupancyGrid::Reader reader(state_->occupancy);
-  return reader.occupied(cellOf<2>(state_->grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
-}
 
 std::size_t IncrementalOverlap::recomputedLastUpdate() const { return state_->recomputed; }
 

@@ -537,10 +537,4 @@ std::function<bool(const Eigen::Vector2d&)> planeCellReader(const std::vector<st
   };
 }
 
-bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p) {
-  const CellGrid grid(cell_size);
-  const std::uint64_t key = keyOf<2>(cellOf<2>(grid.inCells<2>(Eigen::Vector3d(p.x(), p.y(), 0.0))));
-  return std::binary_search(occupied.begin(), occupied.end(), key);
-}
-
 }  // namespace obsgroup

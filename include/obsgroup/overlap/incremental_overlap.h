@@ -85,12 +85,10 @@ class IncrementalOverlap {
   /// Visibility: whether the plane cell holding p (x and y in the re-centred
   /// frame) is occupied in the evidence of the observations present, as of
   /// the last update(): the cells SensedSpaceOverlap::compute gives in
-  /// OverlapResult::occupied_cells for the same observations. False for the
-  /// other models.
-  bool occupiedPlaneCell(const Eigen::Vector2d& p) const;
-  /// The same as a function that remembers the tile it read last (walks
-  /// along a line read the same tile again and again): for one caller at a
-  /// time, until the next change.
+  /// OverlapResult::occupied_cells for the same observations; always false
+  /// for the other models. A function that remembers the tile it read last
+  /// (walks along a line read the same tile again and again): for one caller
+  /// at a time, until the next change.
   std::function<bool(const Eigen::Vector2d&)> planeCellReader() const;
   /// Observations whose region was recomputed by the last update() (the
   /// changed ones and, for visibility, those whose view a change reached).

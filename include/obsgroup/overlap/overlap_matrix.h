@@ -42,7 +42,7 @@ struct OverlapResult {
   std::vector<std::size_t> region_cells;
   /// Visibility: the plane cells occupied in the evidence of all
   /// observations, as the views were cast against (keys ascending;
-  /// occupiedPlaneCell reads them). Empty for the other models.
+  /// planeCellReader reads them). Empty for the other models.
   std::vector<std::uint64_t> occupied_cells;
   std::uint64_t pairs_evaluated = 0;
   std::uint64_t point_tests = 0;

@@ -115,7 +115,7 @@ class ObservationRegions {
   /// the re-centred frame of the WorldPoints (the first sensor at a centre).
   Eigen::Vector3d phase = Eigen::Vector3d::Constant(0.5);
   /// Visibility: the plane cells occupied in the evidence of all
-  /// observations (keys ascending; occupiedPlaneCell reads them); empty for
+  /// observations (keys ascending; planeCellReader reads them); empty for
   /// free space.
   std::vector<std::uint64_t> occupied;
 
@@ -193,10 +193,8 @@ OverlapResult computeRegionOverlap(SensedSpaceModel model, const WorldPoints& wo
 
 /// Whether the plane cell of `cell_size` metres holding p (x and y in the
 /// re-centred frame of the world points) is one of `occupied` (plane cell
-/// keys ascending, as ObservationRegions::occupied and
-/// OverlapResult::occupied_cells hold them).
-bool occupiedPlaneCell(const std::vector<std::uint64_t>& occupied, double cell_size, const Eigen::Vector2d& p);
-/// The same as a function over a bitmap of the cells made once, which
+/// keys, as ObservationRegions::occupied and OverlapResult::occupied_cells
+/// hold them), as a function over a bitmap of the cells made once, which
 /// remembers the tile it read last: for many reads by one caller.
 std::function<bool(const Eigen::Vector2d&)> planeCellReader(const std::vector<std::uint64_t>& occupied,
                                                             double cell_size);
