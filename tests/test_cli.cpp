@@ -1722,7 +1722,7 @@ TEST_F(Cli, StreamGivesTheGroupsOfPartitionAndPrintsEachChange) {
   EXPECT_EQ(p.at("parameters").at("mode"), "stream");
   EXPECT_EQ(p.at("parameters").at("update_every"), 1);
   EXPECT_EQ(p.at("statistics").at("updates"), 77);
-  for (const char* key : {"points", "edges", "groups", "local_map_points"})
+  for (const char* key : {"points", "edges", "groups", "local_map_points", "open_floor_joins"})
     EXPECT_EQ(p.at("statistics").at(key), batch.at("statistics").at(key)) << key;
   EXPECT_TRUE(p.at("timing_s").at("stream").is_number());
   EXPECT_NE(r.err.find("77 observations"), std::string::npos) << r.err;

@@ -216,6 +216,12 @@ TEST(OnlineGrouping, HallBandsJoinedAcrossOpenFloorAsInTheBatch) {
       expectEqualsBatch(online, ObservationGrouping<pcl::PointXYZ>(), "insert " + std::to_string(k));
   }
   EXPECT_EQ(online.getPartition().groups, joined.groups);
+  // The same joins, between the same groups of the split tree, as the batch reports.
+  ASSERT_EQ(online.getOpenFloorJoins().size(), batch.getOpenFloorJoins().size());
+  for (std::size_t j = 0; j < batch.getOpenFloorJoins().size(); ++j) {
+    EXPECT_EQ(online.getOpenFloorJoins()[j].first, batch.getOpenFloorJoins()[j].first);
+    EXPECT_EQ(online.getOpenFloorJoins()[j].second, batch.getOpenFloorJoins()[j].second);
+  }
 }
 
 TEST(OnlineGrouping, ReportsChangesAndKeepsIdsOfUntouchedGroups) {

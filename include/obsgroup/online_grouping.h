@@ -105,6 +105,9 @@ class OnlineGrouping {
   const WeightMatrix& getWeightMatrix() const { return W_; }
   /// What the user should know about the last update() (as ObservationGrouping's).
   const std::vector<std::string>& getWarnings() const { return warnings_; }
+  /// The groups the last update() joined across open floor, as indices of
+  /// its partition's groups before the joins (as ObservationGrouping's).
+  const std::vector<OpenFloorJoin>& getOpenFloorJoins() const { return open_floor_joins_; }
 
   // --- one setting at a time: as ObservationGrouping's; changing one recomputes all at the next update() ---
   void setSensedSpaceModel(SensedSpaceModel model) { params_.model = model; reconfigure(); }
@@ -172,6 +175,7 @@ class OnlineGrouping {
   WeightMatrix spare_W_;  // the W before W_, its storage reused for the next
   StableGroupIds group_ids_;
   std::vector<std::string> warnings_;
+  std::vector<OpenFloorJoin> open_floor_joins_;
   int exact_interval_ = 1;
   int changes_since_exact_ = 0;       // observations inserted or moved since the last exact update
   std::vector<char> pending_;         // by id: row changed since the last exact update

@@ -176,7 +176,8 @@ void streamObservations(const PartitionArgs& args, const std::vector<Observation
                     {"observations_recomputed", totals.observations_recomputed},
                     {"split_nodes_reused", totals.split_nodes_reused},
                     {"split_nodes_computed", totals.split_nodes_computed},
-                    {"split_nodes_ahead", totals.split_nodes_ahead}};
+                    {"split_nodes_ahead", totals.split_nodes_ahead},
+                    {"open_floor_joins", online.getOpenFloorJoins().size()}};
   const double world_s = std::chrono::duration<double>(ReplayClock::Clock::now() - start).count();
   out.timing_s = {{"stream", totals.online_s}, {"world_points", world_s}};
   if (args.stream->realtime) out.timing_s["realtime_wait"] = clock.waitedSeconds();

@@ -236,6 +236,7 @@ std::vector<std::vector<int>> OnlineGrouping<PointT>::partitionExactly(const std
 
 template <typename PointT>
 void OnlineGrouping<PointT>::joinAcrossOpenFloor(const std::vector<int>& ids) {
+  open_floor_joins_.clear();
   if (params_.model != SensedSpaceModel::Visibility || !(params_.open_floor_width > 0.0) || ids.empty()) return;
   // In the re-centred frame the regions are cast in, as the batch's.
   std::vector<Eigen::Vector2d> positions(ids.size());
@@ -245,8 +246,9 @@ void OnlineGrouping<PointT>::joinAcrossOpenFloor(const std::vector<int>& ids) {
                        ? Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN())  // overlaps nothing
                        : Eigen::Vector2d((at - origin_).template head<2>());
   }
-  obsgroup::joinAcrossOpenFloor(partition_, positions, params_.open_floor_width, params_.regions.cell_size,
-                                overlap_->planeCellReader(), params_.regions.max_range);
+  open_floor_joins_ =
+      obsgroup::joinAcrossOpenFloor(partition_, positions, params_.open_floor_width, params_.regions.cell_size,
+                                    overlap_->planeCellReader(), params_.regions.max_range);
 }
 
 template <typename PointT>
