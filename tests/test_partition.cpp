@@ -361,6 +361,72 @@ TEST(RecursivePartition, TheSplitCacheCopiesTheNodesThatHoldNoSourceOfAChange) {
   EXPECT_LT(by_sources.computedNodes(), by_rows.computedNodes());
 }
 
+// Two rooms, A and B, split at the root; then a third room C, linked to B
+// more weakly than A is, is added. The new root splits C off, and the node
+// holding A and B, with its children, moves a level down: the same members
+// and the same block of W, so their decisions are copied from the previous
+// tree, where they stood a level higher, and the tree is still the one
+// computed from scratch, to the bit, depths included.
+TEST(RecursivePartition, TheSplitCacheCopiesNodesThatMovedToAnotherDepth) {
+  const auto rooms = [](int count) {
+    std::vector<WeightedPair> pairs;
+    for (int i = 0; i < 8 * count; ++i)
+      for (int j = i + 1; j < 8 * count; ++j) {
+        const int ri = i / 8, rj = j / 8;
+        const double w = ri == rj ? 1.0 - 0.01 * ((i + j) % 5) : (ri + rj == 1 ? 0.05 : (ri + rj == 3 ? 0.005 : 0.0));
+        if (w > 0) pairs.push_back({i, j, w});
+      }
+    return buildWeightMatrix(8 * count, pairs);
+  };
+  PartitionOptions options;
+  options.min_group_size = 1;
+  std::vector<int> ids(24);
+  for (int i = 0; i < 24; ++i) ids[std::size_t(i)] = i;
+  SplitCache cache;
+  const std::vector<int> first_ids(ids.begin(), ids.begin() + 16);
+  const std::vector<char> none(16, 0);
+  const Partition before = recursivePartition(rooms(2), options, first_ids, none, cache);
+  ASSERT_EQ(before.groups.size(), 2u);
+  ASSERT_EQ(before.splits.size(), 3u);
+  EXPECT_EQ(before.splits[1].depth, 1);
+  std::vector<char> changed(24, 0), sources(24, 0);
+  for (int i = 8; i < 24; ++i) changed[std::size_t(i)] = 1;  // B's rows gain C's entries
+  for (int i = 16; i < 24; ++i) sources[std::size_t(i)] = 1;
+  const WeightMatrix W = rooms(3);
+  const Partition fresh = recursivePartition(W, options);
+  const Partition cached = recursivePartition(W, options, ids, changed, sources, cache);
+  ASSERT_EQ(fresh.groups.size(), 3u);
+  EXPECT_EQ(cached.groups, fresh.groups);
+  ASSERT_EQ(cached.splits.size(), fresh.splits.size());
+  for (std::size_t k = 0; k < fresh.splits.size(); ++k) {
+    EXPECT_EQ(cached.splits[k].members, fresh.splits[k].members) << "node " << k;
+    EXPECT_EQ(cached.splits[k].depth, fresh.splits[k].depth) << "node " << k;
+    EXPECT_EQ(cached.splits[k].children, fresh.splits[k].children) << "node " << k;
+    EXPECT_EQ(0, std::memcmp(&cached.splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << "node " << k;
+  }
+  // The root holds A and B a level lower: A and B, each at depth 2, were at depth 1.
+  const std::vector<int> a_and_b(ids.begin(), ids.begin() + 16);
+  const auto moved = std::find_if(fresh.splits.begin(), fresh.splits.end(),
+                                  [&](const SplitNode& node) { return node.members == a_and_b; });
+  ASSERT_NE(moved, fresh.splits.end());
+  EXPECT_EQ(moved->depth, 1);
+  EXPECT_EQ(cache.reusedNodes(), 3u);   // A and B's node, A, B
+  EXPECT_EQ(cache.computedNodes(), 2u);  // the new root and C
+
+  // Where the depth limit reaches, a node's depth decides it: A and B's
+  // node a level down is a group, not the split it was at the root.
+  options.max_depth = 1;
+  SplitCache limited;
+  recursivePartition(rooms(2), options, first_ids, none, limited);
+  const Partition limited_fresh = recursivePartition(W, options);
+  const Partition limited_cached = recursivePartition(W, options, ids, changed, sources, limited);
+  ASSERT_EQ(limited_fresh.groups.size(), 2u);
+  EXPECT_EQ(limited_cached.groups, limited_fresh.groups);
+  ASSERT_EQ(limited_cached.splits.size(), limited_fresh.splits.size());
+  for (std::size_t k = 0; k < limited_fresh.splits.size(); ++k)
+    EXPECT_EQ(limited_cached.splits[k].outcome, limited_fresh.splits[k].outcome) << "node " << k;
+}
+
 TEST(RecursivePartition, MutualNeighboursSeparateASmallRoomFromACorridorDrivenManyTimes) {
   // A corridor of 120 scans, each overlapping the 40 on either side (a
   // corridor driven again and again), and a room of 8 scans looked into from

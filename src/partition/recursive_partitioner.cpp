@@ -46,9 +46,9 @@ struct Decision {
   bool from_cache = false;  // copied from SplitCache
 };
 
-/// A node's members (by stable id) and depth as a hash key.
-std::uint64_t nodeKey(const std::vector<int>& member_ids, int depth) {
-  std::uint64_t h = 1469598103934665603ull ^ std::uint64_t(depth);
+/// A node's members (by stable id) as a hash key.
+std::uint64_t nodeKey(const std::vector<int>& member_ids) {
+  std::uint64_t h = 1469598103934665603ull;
   for (int id : member_ids) h = (h ^ std::uint64_t(std::uint32_t(id))) * 1099511628211ull;
   return h ^ (std::uint64_t(member_ids.size()) << 32);
 }
@@ -72,7 +72,7 @@ struct SplitCache::Store {
     std::vector<int> member_ids;
     int depth = 0;
     Decision decision;  // children by id
-    std::uint64_t key = 0;  // nodeKey(member_ids, depth)
+    std::uint64_t key = 0;  // nodeKey(member_ids)
   };
   std::unordered_map<std::uint64_t, std::vector<Entry>> entries;
   std::size_t reused = 0, computed = 0;
@@ -92,15 +92,20 @@ struct SplitCache::Store {
   /// new since (Partitioner::guessPath).
   std::vector<int> ids;
 
-  Entry* find(const std::vector<int>& member_ids, int depth) {
-    const auto it = entries.find(nodeKey(member_ids, depth));
+  /// The decision of the node with these members at `depth`, or at any
+  /// depth when both lie below `max_depth`: there a node's decision does
+  /// not depend on its depth, which only numbers its children (an insert
+  /// that adds a split above a part of the tree moves that part a level
+  /// down, and its nodes are still the same).
+  Entry* find(const std::vector<int>& member_ids, int depth, int max_depth) {
+    const auto it = entries.find(nodeKey(member_ids));
     if (it == entries.end()) return nullptr;
     for (Entry& e : it->second)
-      if (e.depth == depth && e.member_ids == member_ids) return &e;
+      if ((e.depth == depth || (depth < max_depth && e.depth < max_depth)) && e.member_ids == member_ids) return &e;
     return nullptr;
   }
   void add(std::vector<int> member_ids, int depth, Decision decision) {
-    const std::uint64_t key = nodeKey(member_ids, depth);
+    const std::uint64_t key = nodeKey(member_ids);
     entries[key].push_back({std::move(member_ids), depth, std::move(decision), key});
   }
   /// Moves over an entry of another store, whose decision a run copied.
@@ -246,9 +251,10 @@ class Partitioner {
     if (!reuse_) return false;
     for (int i : current.members)
       if (reuse_->sources[i]) return false;
-    SplitCache::Store::Entry* entry = reuse_->previous.find(idsOf(current.members), current.depth);
+    SplitCache::Store::Entry* entry = reuse_->previous.find(idsOf(current.members), current.depth, options_.max_depth);
     if (!entry) return false;
     d = entry->decision;
+    d.child_depth += current.depth - entry->depth;
     // A child's members are the node's, each of them in the graph.
     for (auto& child : d.children)
       for (int& member : child) member = index_of_id_[std::size_t(member)];
@@ -279,12 +285,12 @@ class Partitioner {
     Decision decision;
   };
   void addGuessed(std::vector<int> member_ids, int depth, Decision decision) {
-    const std::uint64_t key = nodeKey(member_ids, 0);
+    const std::uint64_t key = nodeKey(member_ids);
     guessed_[key].push_back({std::move(member_ids), depth, std::move(decision)});
   }
   /// A node solved ahead with these members whose decision holds at `depth`.
   Guessed* findGuessed(const std::vector<int>& member_ids, int depth) {
-    const auto it = guessed_.find(nodeKey(member_ids, 0));
+    const auto it = guessed_.find(nodeKey(member_ids));
     if (it == guessed_.end()) return nullptr;
     const int max_depth = options_.max_depth;
     for (Guessed& g : it->second)
@@ -294,7 +300,7 @@ class Partitioner {
 
   /// Guesses the nodes below `node` (about to be solved) that will need
   /// solving: the previous run's children of the node it was then (its
-  /// members without the new ones, at the same depth), each new member
+  /// members without the new ones, at any depth below max_depth), each new member
   /// joining the child it is most strongly linked to; then the same below
   /// each guessed child holding a source, down to the leaves. Appends to
   /// `guesses` those not solved or guessed already.
@@ -314,7 +320,7 @@ class Partitioner {
     while (!pending.empty()) {
       Pending at = std::move(pending.back());
       pending.pop_back();
-      const auto* entry = reuse_->previous.find(idsOf(at.old_members), at.depth);
+      const auto* entry = reuse_->previous.find(idsOf(at.old_members), at.depth, options_.max_depth);
       if (!entry || entry->decision.children.size() < 2) continue;
       const auto& children = entry->decision.children;  // by id
       std::vector<std::vector<int>> old_children(children.size()), predicted(children.size());
@@ -354,7 +360,7 @@ class Partitioner {
       if (!unplaced.empty()) continue;  // the guess would miss members: none of its children is right
       // Each child holding a source will be solved (the others are cached):
       // guessed, and followed down.
-      const int child_depth = entry->decision.child_depth;
+      const int child_depth = at.depth + (entry->decision.child_depth - entry->depth);
       for (std::size_t c = 0; c < children.size(); ++c) {
         SplitNode guess;
         guess.members = old_children[c];
@@ -376,7 +382,9 @@ class Partitioner {
   /// moved over from the previous run's (no node is visited twice in a run).
   void record(const SplitNode& current, const Decision& d, SplitCache::Store::Entry* copied) {
     if (d.from_cache) {
-      // The entry it was copied from holds this node's ids and depth: moved over as it is.
+      // The entry it was copied from holds this node's ids: moved over, at this node's depth.
+      copied->decision.child_depth = d.child_depth;
+      copied->depth = current.depth;
       reuse_->next.take(*copied);
       ++reuse_->next.reused;
       return;

@@ -112,11 +112,14 @@ Partition recursivePartition(const WeightMatrix& W, const PartitionOptions& opti
 /// The decisions of the split tree of one recursivePartition, kept for the
 /// next on a graph that differs in the rows of a few nodes (online grouping:
 /// observations inserted, moved or removed). A node's decision depends only
-/// on its members' block of W, its depth and the options (each node orders
-/// its own elimination, see FiedlerOptions::elimination_rank), so a node with
-/// the same members, at the same depth, none of whose rows changed, is
-/// decided as before: its decision is copied, bit for bit, instead of solved.
-/// The result is then the one recursivePartition gives from scratch.
+/// on its members' block of W and the options (each node orders its own
+/// elimination, see FiedlerOptions::elimination_rank), and on its depth only
+/// where PartitionOptions::max_depth reaches; so a node with the same
+/// members, none of whose rows changed, is decided as before, at any depth
+/// below max_depth (a split added above a part of the tree moves that part
+/// down a level; its depth then only numbers its children): its decision is
+/// copied, bit for bit, instead of solved. The result is then the one
+/// recursivePartition gives from scratch.
 class SplitCache {
  public:
   SplitCache();
