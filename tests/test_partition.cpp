@@ -404,7 +404,7 @@ TEST(RecursivePartition, TheSplitCacheCopiesNodesThatMovedToAnotherDepth) {
     EXPECT_EQ(cached.splits[k].children, fresh.splits[k].children) << "node " << k;
     EXPECT_EQ(0, std::memcmp(&cached.splits[k].ncut, &fresh.splits[k].ncut, sizeof(double))) << "node " << k;
   }
-  // The root holds A and B a level lower: A and B, each at depth 2, were at depth 1.
+  // A and B's node, the root before, now stands at depth 1 (A and B at depth 2, at 1 before).
   const std::vector<int> a_and_b(ids.begin(), ids.begin() + 16);
   const auto moved = std::find_if(fresh.splits.begin(), fresh.splits.end(),
                                   [&](const SplitNode& node) { return node.members == a_and_b; });

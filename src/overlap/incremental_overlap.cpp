@@ -499,7 +499,6 @@ std::function<bool(const Eigen::Vector2d&)> IncrementalOverlap::planeCellReader(
   };
 }
 
-
 std::size_t IncrementalOverlap::recomputedLastUpdate() const { return state_->recomputed; }
 
 WeightMatrix IncrementalOverlap::weightMatrix(double diagonal) const { return weightMatrix(diagonal, nullptr); }
