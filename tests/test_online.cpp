@@ -283,6 +283,25 @@ TEST(OnlineGrouping, ViewsClosedByTheirOwnPointsAreNotRecomputedWhenOthersFlipCe
   EXPECT_GT(recomputed[1], 1u);
 }
 
+TEST(OnlineGrouping, ForwardLaserViewsEqualBatchAfterEveryInsert) {
+  // A forward laser's views read the shared occupancy behind the robot, and
+  // an insert recomputes only those whose rays (and the door-width runs
+  // beside them) reach a flipped cell: W stays the batch's, bit for bit.
+  auto obs = test::simulate<pcl::PointXYZ>(sim::office(), sim::officeRoute(77), sim::laser180());
+  std::vector<Eigen::Isometry3d> truth;
+  for (const auto& o : obs) truth.push_back(o.pose);
+  const auto drifted = sim::drift(truth, 7);
+  OnlineGrouping<pcl::PointXYZ> online;
+  std::size_t recomputed_others = 0;
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    online.insert(obs[k].cloud, drifted[k]);
+    recomputed_others += online.update().observations_recomputed - 1;
+    if (k % 4 == 3 || k + 1 == obs.size())
+      expectEqualsBatch(online, batchLike(SensedSpaceModel::Visibility), "insert " + std::to_string(k));
+  }
+  EXPECT_GT(recomputed_others, 0u);  // the views behind the robot were recomputed
+}
+
 TEST(OnlineGrouping, LoopClosureRepartitionsOnlyTheGroupsItTouches) {
   // A long building, points model: a row of W changes only for the moved
   // observations and the ones they overlap.

@@ -36,6 +36,7 @@ struct Slot {
   // As last computed (they may lag `points` until update()):
   std::vector<std::uint64_t> region, hit, crossed;
   bool reads_occupancy = true;  // visibility: its region read the shared occupancy grid
+  region_cells::Cell<2> read_lo{}, read_hi{};  // where (ViewWidths::read_lo, read_hi)
   std::vector<PairCounts> row;  // ascending j
 };
 
@@ -275,18 +276,19 @@ struct IncrementalOverlap::State {
     return flipped;
   }
 
-  /// The present slots whose view (the box of cells within range of the
-  /// sensor, as visibilityOf casts it) holds a flipped cell, among those
-  /// whose last view read the shared occupancy at all.
+  /// The present slots whose view depended on a flipped cell's occupancy
+  /// (the box of ViewWidths::read_lo, read_hi holds it), among those whose
+  /// last view read the shared occupancy at all.
   std::vector<int> viewsReaching(const std::vector<std::uint64_t>& flipped) const {
     std::vector<int> out;
     if (flipped.empty()) return out;
-    const double range = params.max_range / grid.size;
     for (int i = 0; i < int(slots.size()); ++i) {
       const Slot& s = slots[i];
       // A view that read none of the shared occupancy cannot change with it.
       if (!s.present || s.points.empty() || !s.reads_occupancy) continue;
-      const auto [lo, hi] = boxAround<2>(grid.inCells<2>(s.origin), range);
+      const auto& lo = s.read_lo;
+      const auto& hi = s.read_hi;
+      if (lo[0] > hi[0] || lo[1] > hi[1]) continue;
       const std::uint64_t first = keyOf<2>(lo), last = keyOf<2>(hi);
       // Keys ascend with x first: only flipped keys between the box's
       // corners can lie in it.
@@ -310,6 +312,7 @@ struct IncrementalOverlap::State {
     if (model == SensedSpaceModel::Visibility) {
       visibilityOf(points, s.origin, params, grid, planar_used, reader, own, marker2, widths, s.region);
       s.reads_occupancy = widths.read_occupancy;
+      s.read_lo = widths.read_lo, s.read_hi = widths.read_hi;
     } else if (!planar_used) {
       freeSpaceOf<3>(points, s.origin, params, grid, marker3, s.region);
     } else {

@@ -594,6 +594,13 @@ struct ViewWidths {
   /// depends on its own points alone (online grouping need not recompute it
   /// when others flip cells).
   bool read_occupancy = false;
+  /// The cells whose shared occupancy the last view depended on, as a box
+  /// (read_lo > read_hi on an axis: none): every cell its rays that read the
+  /// shared occupancy entered, grown by the reach of a door-width run
+  /// (OpeningWidths::run at a cell is narrower than a door or not by the
+  /// cells within that many steps of it). A cell flipped outside it cannot
+  /// change the view.
+  Cell<2> read_lo{}, read_hi{};
 };
 
 /// The cells visible from observation i's position: rays all around it at a
@@ -603,6 +610,7 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
                          const CellGrid& grid, bool planar, OccupancyGrid::Reader& occupancy, RegionMarker<2>& own,
                          RegionMarker<2>& marker, ViewWidths& widths, std::vector<std::uint64_t>& out) {
   widths.read_occupancy = false;
+  widths.read_lo = {1, 1}, widths.read_hi = {0, 0};
   if (points.empty()) return;  // an observation with no point sensed nothing
   const double range = params.max_range / grid.size, clear = params.clearance / params.max_range;
   const auto o = grid.inCells<2>(origin);
@@ -657,6 +665,14 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
   const auto ray_end = [&](int r) {
     return std::array<double, 2>{o[0] + range * directions[r][0], o[1] + range * directions[r][1]};
   };
+  struct ReadBox {
+    Cell<2> lo{std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max()};
+    Cell<2> hi{std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::min()};
+    void add(const Cell<2>& c) {
+      lo = {std::min(lo[0], c[0]), std::min(lo[1], c[1])};
+      hi = {std::max(hi[0], c[0]), std::max(hi[1], c[1])};
+    }
+  } read_box;
   // The visitor of ray r's walk through the cells it sees: free_cell(cell,
   // widths) on each free one (false stops it), seen(cell) on every cell.
   const auto ray_visitor = [&](int r, auto& free_cell, auto& seen) {
@@ -669,9 +685,10 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
     // Only the occupied cells a ray starts among are passed, and only
     // within the clearance: once it has crossed a free cell, the next
     // occupied cell is a wall seen from inside and stops it.
-    return [&free_cell, &seen, &own, &occupancy, clear, own_view, ray_widths, crossed_free = false](
+    return [&free_cell, &seen, &own, &occupancy, clear, own_view, ray_widths, &reads = read_box, crossed_free = false](
                const Cell<2>& c, double t) mutable {
       seen(c);
+      if (!own_view) reads.add(c);
       if (!own.marked(c) && (own_view || !occupancy.occupied(c))) {
         crossed_free = true;
         return bool(free_cell(c, *ray_widths));
@@ -746,6 +763,15 @@ inline void visibilityOf(PointSpan points, const Eigen::Vector3d& origin, const 
         traversePair(o, ray_end(r), ray_visitor(r, free_r, mark), ray_end(q), ray_visitor(q, free_q, mark));
       });
   marker.emit(out);
+  if (read_box.lo[0] <= read_box.hi[0]) {
+    // A run is narrower than a door by the cells within door_width / cell
+    // (+ 1 for rounding) steps of the cell it is read at, diagonal steps
+    // included (DoorCrossing's narrow_below).
+    const std::int64_t reach = doors ? std::int64_t(std::ceil(params.door_width / grid.size)) + 1 : 0;
+    // Runs end at the view's box (OpeningWidths::kOpen beyond it).
+    widths.read_lo = {std::max(lo[0], read_box.lo[0] - reach), std::max(lo[1], read_box.lo[1] - reach)};
+    widths.read_hi = {std::min(hi[0], read_box.hi[0] + reach), std::min(hi[1], read_box.hi[1] + reach)};
+  }
 }
 
 /// Scratch of occupancyEvidence, reused across observations.
