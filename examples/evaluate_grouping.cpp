@@ -22,8 +22,10 @@
 //
 //   evaluate_grouping --write-logs FOLDER [selection]
 //       writes the selected laser datasets as CARMEN logs (ROBOTLASER1, the
-//       poses the grouping sees) with their labels in the same JSON, to run
-//       `obsgroup partition` on them and look at its pictures.
+//       poses the grouping sees), the depth camera's and the lidar's as
+//       folders of PCD files with their poses.txt, and the labels of each
+//       building in the same JSON, to run `obsgroup partition` on them and
+//       look at its pictures.
 //
 // Run with --help for the parameters and the selection of datasets.
 
@@ -34,6 +36,8 @@
 
 #include <obsgroup/maps/odometry_correction.h>
 #include <obsgroup/observation_grouping.h>
+
+#include <pcl/io/pcd_io.h>
 #ifdef OBSGROUP_EVALUATE_LABELLED_LOGS
 #include <obsgroup/io/carmen_reader.h>
 
@@ -46,6 +50,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -404,8 +409,30 @@ int evaluateOneConfiguration(const std::vector<Dataset>& datasets, const Configu
 /// Writes the laser datasets of `buildings` as CARMEN logs and their places
 /// as labels (the format of --labels): FOLDER/BUILDING_SENSOR_POSES.clf and
 /// FOLDER/BUILDING_labels.json.
+/// A cloud dataset as `obsgroup partition` reads it: FOLDER/pcd/%06d.pcd
+/// (binary, the sensor's frame) and FOLDER/poses.txt (TUM, the poses the
+/// grouping sees).
+void writeCloudSequence(const std::string& folder, const Dataset& d) {
+  std::filesystem::create_directories(folder + "/pcd");
+  std::ofstream poses(folder + "/poses.txt");
+  poses << "# timestamp tx ty tz qx qy qz qw (" << d.title << "; " << sim::describe(d.sensor) << ", "
+        << toString(d.poses) << " poses; obsgroup's scan simulator, examples/evaluate_grouping.cpp)\n";
+  for (std::size_t k = 0; k < d.observations.size(); ++k) {
+    const Observation<pcl::PointXYZ>& o = d.observations[k];
+    if (pcl::io::savePCDFileBinary(folder + "/pcd/" + format("%06zu.pcd", k), *o.cloud) != 0)
+      throw std::runtime_error("cannot write into " + folder + "/pcd");
+    const Eigen::Quaterniond q(o.pose.linear());
+    const Eigen::Vector3d t = o.pose.translation();
+    poses << format("%.1f %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", 0.5 * double(k), t.x(), t.y(), t.z(), q.x(), q.y(),
+                    q.z(), q.w());
+  }
+  if (!poses) throw std::runtime_error("cannot write " + folder + "/poses.txt");
+  std::cout << "wrote " << folder << "\n";
+}
+
 int writeLogs(const std::string& folder, const std::vector<std::string>& buildings,
-              const std::vector<sim::Sensor>& sensors, const std::vector<PoseSource>& pose_sources) {
+              const std::vector<sim::Sensor>& sensors, const std::vector<PoseSource>& pose_sources,
+              const sim::DepthCamera& depth_camera) {
   for (const std::string& key : buildings) {
     const sim::Building building = sim::makeBuilding(key);
     const sim::Places places = sim::placesAlong(building.plan, building.route, kStretchLength);
@@ -426,7 +453,11 @@ int writeLogs(const std::string& folder, const std::vector<std::string>& buildin
     const std::vector<Eigen::Isometry3d> drifted = sim::drift(truth, kDriftSeed);
     const std::vector<Eigen::Isometry3d> biased = sim::biasedDrift(truth);
     for (sim::Sensor sensor : sensors) {
-      if (sensor == sim::Sensor::Depth || sensor == sim::Sensor::Lidar) continue;  // not a CARMEN log
+      if (sensor == sim::Sensor::Depth || sensor == sim::Sensor::Lidar) {  // clouds, not a CARMEN log
+        for (const Dataset& d : makeDatasets({key}, {sensor}, pose_sources, depth_camera))
+          writeCloudSequence(folder + "/" + key + "_" + sim::toString(sensor) + "_" + toString(d.poses), d);
+        continue;
+      }
       const sim::LaserModel laser = sensor == sim::Sensor::Laser360 ? sim::laser360() : sim::laser180();
       const double step = laser.full_turn ? laser.field_of_view / laser.beams : laser.field_of_view / (laser.beams - 1);
       for (PoseSource source : pose_sources) {
@@ -723,7 +754,8 @@ const char* kUsage =
     "  --datasets office,loop,rooms20,smallrooms,hall  --sensors laser360,laser180,depth[,lidar]  --poses exact,drift[,bias]\n"
     "real logs instead of the simulated buildings (each --log with its --labels, in order):\n"
     "  --log LOG --labels LABELS.json\n"
-    "the selected laser datasets as CARMEN logs with their labels, for obsgroup partition and --log:\n"
+    "the selected datasets with their labels, for obsgroup partition and --log (lasers: CARMEN logs;\n"
+    "depth camera, lidar: folders of PCD files and poses.txt):\n"
     "  --write-logs FOLDER\n"
     "each default at 75% and 125% (rooms found and pure; with --output, the page's 'sweep' section):\n"
     "  --sweep defaults [--log LOG --labels LABELS.json ...] [selection]\n";
@@ -832,7 +864,7 @@ int main(int argc, char** argv) {
   }
   if (!write_logs.empty()) {
     try {
-      return writeLogs(write_logs, buildings, sensors, pose_sources);
+      return writeLogs(write_logs, buildings, sensors, pose_sources, depth_camera);
     } catch (const std::exception& e) {
       std::cerr << "error: " << e.what() << "\n";
       return 1;
