@@ -100,13 +100,37 @@ TEST(OpenFloor, EnclosedByWallsTheRouteCameNear) {
     return p.x() >= -7 && p.x() <= 29 && std::abs(p.y() - 5) <= 8;
   };
   EXPECT_TRUE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, walls.occupied(), near_route));
-  // Walls farther than the reach do not enclose, nor walls no view came near.
-  EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 10.0, walls.occupied(), near_route));
+  // Walls farther than the reach do not enclose (all 5 m or more away
+  // here), nor walls no view came near.
+  EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 4.0, walls.occupied(), near_route));
   EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, walls.occupied(),
                              [](const Eigen::Vector2d& p) { return std::abs(p.y() - 5) <= 3; }));
   // Open country: nothing to meet.
   const Walls none;
   EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, none.occupied(), near_route));
+}
+
+TEST(OpenFloor, AGapInTheWallsNoViewLookedAtLetsAtMostTwoRaysOut) {
+  // A forward camera leaves stretches of a hall's walls unseen: a ray that
+  // slips out through such a gap meets nothing. A 3 m gap in the south wall
+  // lets one or two of the sixteen rays out along the step, and the hall is
+  // still enclosed; a 10 m gap lets three or more out, and it is not.
+  const SeenAt seen = [](const Eigen::Vector2d&) { return true; };
+  const auto hallWithGap = [](double x0, double x1) {
+    Walls walls;
+    walls.segment({0, 10}, {16, 10}).segment({0, 0}, {0, 10}).segment({16, 0}, {16, 10});
+    walls.segment({0, 0}, {x0, 0}).segment({x1, 0}, {16, 0});
+    return walls;
+  };
+  const Walls narrow_gap = hallWithGap(5.5, 8.5), wide_gap = hallWithGap(2.0, 12.0);
+  EXPECT_TRUE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, narrow_gap.occupied(), seen));
+  EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, wide_gap.occupied(), seen));
+  // A wall beyond the gap that no view came near is not open floor either.
+  Walls beyond = hallWithGap(5.5, 8.5);
+  beyond.segment({-20, -15}, {36, -15});
+  EXPECT_TRUE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, beyond.occupied(), seen));
+  EXPECT_FALSE(enclosedAlong({7, 5}, {8, 5}, kCell, 30.0, beyond.occupied(),
+                             [](const Eigen::Vector2d& p) { return p.y() > -1; }));
 }
 
 TEST(OpenFloor, BandsOfAHallAreJoinedAndTheRoomBehindItsDoorIsNot) {

@@ -112,6 +112,7 @@ bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double ce
   const double step = 0.5 * cell;
   for (int s = 0; s <= intervals; ++s) {
     const Eigen::Vector2d p = a + (double(s) / double(intervals)) * (b - a);
+    int open = 0;
     for (int direction = 0; direction < 2 * kLines; ++direction) {
       const double angle = 3.14159265358979323846 * double(direction) / double(kLines);
       const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
@@ -119,7 +120,11 @@ bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double ce
       // near, not a structure far off that no view reached.
       double t = 0.0;
       while (t < reach && !occupied(p + t * d)) t += step;
-      if (t >= reach || !seen(p + t * d)) return false;
+      if (t >= reach) {
+        if (++open > kMaxOpenDirections) return false;
+      } else if (!seen(p + t * d)) {
+        return false;
+      }
     }
   }
   return true;

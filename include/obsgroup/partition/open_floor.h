@@ -42,12 +42,18 @@ double narrowestChord(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double
 /// near (within a view's range of one).
 using SeenAt = std::function<bool(const Eigen::Vector2d&)>;
 
+/// Rays of enclosedAlong that may meet no occupied cell within reach, of
+/// sixteen: a forward camera leaves stretches of a hall's walls unseen, and
+/// a ray slips out through such a gap (docs/method.md, "Open floor").
+constexpr int kMaxOpenDirections = 2;
+
 /// Whether every point of the segment from `a` to `b` (sampled as by
 /// narrowestChord) meets, in each of sixteen directions within `reach`
-/// metres, an occupied cell that the observations saw from near (`seen`):
-/// the floor is enclosed by walls the route came near, as a room's or a
-/// hall's is. Outdoors, round a building, rays pass between trees and posts
-/// to structures no view reached, or to nothing.
+/// metres, an occupied cell that the observations saw from near (`seen`),
+/// but for at most kMaxOpenDirections directions that meet none: the floor
+/// is enclosed by walls the route came near, as a room's or a hall's is.
+/// Outdoors, round a building, rays pass between trees and posts to
+/// structures no view reached.
 bool enclosedAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double reach,
                    const OccupiedAt& occupied, const SeenAt& seen);
 
