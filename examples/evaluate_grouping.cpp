@@ -406,9 +406,6 @@ int evaluateOneConfiguration(const std::vector<Dataset>& datasets, const Configu
   return s.errors ? 1 : 0;
 }
 
-/// Writes the laser datasets of `buildings` as CARMEN logs and their places
-/// as labels (the format of --labels): FOLDER/BUILDING_SENSOR_POSES.clf and
-/// FOLDER/BUILDING_labels.json.
 /// A cloud dataset as `obsgroup partition` reads it: FOLDER/pcd/%06d.pcd
 /// (binary, the sensor's frame) and FOLDER/poses.txt (TUM, the poses the
 /// grouping sees).
@@ -430,6 +427,10 @@ void writeCloudSequence(const std::string& folder, const Dataset& d) {
   std::cout << "wrote " << folder << "\n";
 }
 
+/// Writes the datasets of `buildings` and their places as labels (the
+/// format of --labels): FOLDER/BUILDING_labels.json, the lasers' as CARMEN
+/// logs FOLDER/BUILDING_SENSOR_POSES.clf, the depth camera's and the lidar's
+/// as folders FOLDER/BUILDING_SENSOR_POSES/ (writeCloudSequence).
 int writeLogs(const std::string& folder, const std::vector<std::string>& buildings,
               const std::vector<sim::Sensor>& sensors, const std::vector<PoseSource>& pose_sources,
               const sim::DepthCamera& depth_camera) {
