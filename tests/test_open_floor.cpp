@@ -155,6 +155,28 @@ TEST(OpenFloor, BandsOfAHallAreJoinedAndTheRoomBehindItsDoorIsNot) {
   EXPECT_EQ(wide.partition.groups.size(), 3u);
 }
 
+TEST(OpenFloor, PillarsBetweenTheBandsDoNotNarrowTheFloorAWallDoes) {
+  // Two pillars of 0.6 m, 3.4 m apart, where the route crosses from the
+  // first band to the second (x = 8): across the route they leave 2.8 m of
+  // free space, but the floor flows round them, and the bands are joined.
+  // Two stretches of wall of 1.6 m there instead keep them apart.
+  Walls pillars = hallAndRoom();
+  pillars.box(7.7, 2.9, 8.3, 3.5).box(7.7, 6.5, 8.3, 7.1);
+  EXPECT_LT(narrowestChord({7.5, 5}, {8.5, 5}, kCell, 4.5, pillars.occupied()), 3.0);
+  Route r = alongTheMiddle();
+  const std::vector<OpenFloorJoin> joins = joinAcrossOpenFloor(r.partition, r.positions, 4.5, kCell, pillars.occupied(), 6.0);
+  ASSERT_EQ(joins.size(), 1u);
+  EXPECT_EQ(joins[0].first, 0);
+  EXPECT_EQ(joins[0].second, 1);
+  EXPECT_EQ(r.partition.groups.size(), 2u);
+
+  Walls wall_ends = hallAndRoom();
+  wall_ends.segment({8, 1.9}, {8, 3.5}).segment({8, 6.5}, {8, 8.1});
+  Route blocked = alongTheMiddle();
+  EXPECT_TRUE(joinAcrossOpenFloor(blocked.partition, blocked.positions, 4.5, kCell, wall_ends.occupied(), 6.0).empty());
+  EXPECT_EQ(blocked.partition.groups.size(), 3u);
+}
+
 TEST(OpenFloor, NothingIsJoinedInOpenCountryOrThroughAnObservationWithoutPosition) {
   const Walls none;
   Route open = alongTheMiddle();

@@ -70,6 +70,39 @@ double walkChords(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cel
   return narrowest;
 }
 
+/// Whether the occupied cell holding `q` belongs to a piece of occupied
+/// cells (8-connected, cells of `cell` metres) that fits within
+/// `extent_cells` cells along both axes. Walks the piece from `q` and stops
+/// as soon as it outgrows that; only cells within that many of `q` can
+/// belong to a piece that fits, so the walk's marks are a small square.
+bool withinSmallPiece(const Eigen::Vector2d& q, double cell, int extent_cells, const OccupiedAt& occupied) {
+  const int side = 2 * extent_cells + 1;
+  std::vector<char> marked(std::size_t(side) * std::size_t(side), 0);
+  const auto index = [&](int i, int j) { return std::size_t(i + extent_cells) * std::size_t(side) + std::size_t(j + extent_cells); };
+  std::vector<std::pair<int, int>> stack{{0, 0}};
+  marked[index(0, 0)] = 1;
+  int lo_i = 0, hi_i = 0, lo_j = 0, hi_j = 0;
+  while (!stack.empty()) {
+    const auto [i, j] = stack.back();
+    stack.pop_back();
+    for (int di = -1; di <= 1; ++di)
+      for (int dj = -1; dj <= 1; ++dj) {
+        const int ni = i + di, nj = j + dj;
+        if (std::abs(ni) > extent_cells || std::abs(nj) > extent_cells) {
+          // Beyond the square: the piece fits only if this cell is free.
+          if (occupied(q + cell * Eigen::Vector2d(ni, nj))) return false;
+          continue;
+        }
+        if (marked[index(ni, nj)] || !occupied(q + cell * Eigen::Vector2d(ni, nj))) continue;
+        marked[index(ni, nj)] = 1;
+        lo_i = std::min(lo_i, ni), hi_i = std::max(hi_i, ni), lo_j = std::min(lo_j, nj), hi_j = std::max(hi_j, nj);
+        if (hi_i - lo_i + 1 > extent_cells || hi_j - lo_j + 1 > extent_cells) return false;
+        stack.emplace_back(ni, nj);
+      }
+  }
+  return true;
+}
+
 /// The observations' positions by square cells of `range`: whether a point
 /// lies within `range` of one looks at the nine cells around it.
 class NearPositions {
@@ -145,6 +178,12 @@ std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::
     if (!near) near = std::make_unique<NearPositions>(positions, kSeenBeyondViews * view_range);
     return near->near(q);
   };
+  // Free space flows round a pillar or a piece of furniture: such a piece
+  // does not narrow a chord, a wall does (the enclosure still meets both).
+  const int clutter_cells = int(std::floor(kClutterExtent / cell + 1e-9));
+  const OccupiedAt walls = [&](const Eigen::Vector2d& q) {
+    return occupied(q) && !(clutter_cells > 0 && withinSmallPiece(q, cell, clutter_cells, occupied));
+  };
   // Per pair of groups the narrowest chord of its steps so far; a pair is
   // settled as soon as one step is narrower than `width`.
   std::map<std::pair<int, int>, double> narrowest;
@@ -157,9 +196,9 @@ std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::
     const Eigen::Vector2d &from = positions[std::size_t(k)], &to = positions[std::size_t(k + 1)];
     double chord = 0.0;  // a step from or to an observation without a position is no evidence
     if (from.allFinite() && to.allFinite()) {
-      chord = walkChords(from, to, cell, width, width, occupied);
+      chord = walkChords(from, to, cell, width, width, walls);
       // Open floor (rare): walk every line in full, for the join's record.
-      if (chord >= width) chord = narrowestChord(from, to, cell, width, occupied);
+      if (chord >= width) chord = narrowestChord(from, to, cell, width, walls);
       if (chord >= width && !enclosedAlong(from, to, cell, reach, occupied, seen)) chord = 0.0;
     }
     if (it == narrowest.end())

@@ -66,9 +66,15 @@ constexpr double kOpenFloorReach = 30.0;
 /// round a building outdoors lie farther (docs/method.md, "Open floor").
 constexpr double kSeenBeyondViews = 4.0 / 3.0;
 
+/// Occupied pieces that fit within this many metres along both axes (a
+/// pillar, a piece of furniture) do not narrow the chords of
+/// joinAcrossOpenFloor: the free space flows round them (docs/method.md,
+/// "Open floor").
+constexpr double kClutterExtent = 1.0;
+
 /// Joins the groups of `partition` between which every step of the route
-/// has a narrowest chord (narrowestChord, sides capped at `width`) of at
-/// least `width` metres and is enclosed (enclosedAlong, `reach`; a wall
+/// has a narrowest chord (narrowestChord, sides capped at `width`, pieces
+/// within kClutterExtent free) of at least `width` metres and is enclosed (enclosedAlong, `reach`; a wall
 /// seen from near: within kSeenBeyondViews x `view_range` metres of an
 /// observation's position).
 /// Observation k stands at positions[k] and the route goes through the
