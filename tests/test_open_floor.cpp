@@ -156,10 +156,10 @@ TEST(OpenFloor, BandsOfAHallAreJoinedAndTheRoomBehindItsDoorIsNot) {
 }
 
 TEST(OpenFloor, PillarsBetweenTheBandsDoNotNarrowTheFloorAWallDoes) {
-  // Two pillars of 0.6 m, 3.4 m apart, where the route crosses from the
-  // first band to the second (x = 8): across the route they leave 2.8 m of
-  // free space, but the floor flows round them, and the bands are joined.
-  // Two stretches of wall of 1.6 m there instead keep them apart.
+  // Two pillars of 0.6 m, 3 m apart, where the route crosses from the first
+  // band to the second (x = 8): across the route they leave less than 3 m
+  // of free space, but the floor flows round them, and the bands are
+  // joined. Two stretches of wall of 1.6 m there instead keep them apart.
   Walls pillars = hallAndRoom();
   pillars.box(7.7, 2.9, 8.3, 3.5).box(7.7, 6.5, 8.3, 7.1);
   EXPECT_LT(narrowestChord({7.5, 5}, {8.5, 5}, kCell, 4.5, pillars.occupied()), 3.0);

@@ -74,9 +74,9 @@ constexpr double kClutterExtent = 1.0;
 
 /// Joins the groups of `partition` between which every step of the route
 /// has a narrowest chord (narrowestChord, sides capped at `width`, pieces
-/// within kClutterExtent free) of at least `width` metres and is enclosed (enclosedAlong, `reach`; a wall
-/// seen from near: within kSeenBeyondViews x `view_range` metres of an
-/// observation's position).
+/// within kClutterExtent free) of at least `width` metres and is enclosed
+/// (enclosedAlong, `reach`; a wall seen from near: within kSeenBeyondViews x
+/// `view_range` metres of an observation's position).
 /// Observation k stands at positions[k] and the route goes through the
 /// observations in index order; a non-finite position (an observation with
 /// no point) joins nothing. The groups stay ascending and ordered by their
