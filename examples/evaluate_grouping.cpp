@@ -55,6 +55,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -215,6 +216,9 @@ struct Configuration {
   double mutual_neighbours_share = GroupingParameters{}.mutual_neighbours_share;
   /// GroupingParameters::open_floor_width (the visibility model's alone).
   double open_floor_width = GroupingParameters{}.open_floor_width;
+  /// Groups whose places meet through a passage are joined, as `obsgroup
+  /// partition` does (--join-passages; the visibility model's alone).
+  bool join_passages = true;
   int threads = 0;  ///< 0: all cores
   /// Off: grouped at the poses given; Auto: at the poses the command groups
   /// at (each dataset's `corrected`).
@@ -235,7 +239,7 @@ struct Configuration {
              (model != SensedSpaceModel::Visibility || open_floor_width == p.open_floor_width);
     };
     const bool paper = same_method(GroupingParameters::paper());
-    const bool library_default = same_method(GroupingParameters{});
+    const bool library_default = same_method(GroupingParameters{}) && join_passages;
     return toString(model) + delta + ", split " + toString(split) + format(", Ncut < %g", ncut_threshold) +
            (boundary_passes > 0 ? format(", %d boundary passes", boundary_passes) : std::string()) +
            (mutual_neighbours > 0 || mutual_neighbours_share > 0
@@ -244,6 +248,7 @@ struct Configuration {
            (model == SensedSpaceModel::Visibility && open_floor_width > 0
                 ? format(", open floor %g m", open_floor_width)
                 : std::string()) +
+           (model == SensedSpaceModel::Visibility && !join_passages ? ", passages not joined" : "") +
            (correct_odometry == OdometryCorrection::Off && !paper ? ", poses as given" : "") +
            (paper ? " (the paper)" : "") +
            (library_default && correct_odometry != OdometryCorrection::Off ? " (**the default**)" : "");
@@ -253,11 +258,13 @@ struct Configuration {
   std::string parameters() const {
     return format("model=%s split=%s delta=%g cell=%g range=%g clearance=%g min-observations=%d band=%g..%g "
                   "door-width=%g door-depth=%g min-group-size=%d ncut-threshold=%g boundary-passes=%d "
-                  "mutual-neighbours=%g mutual-neighbours-share=%g open-floor-width=%g correct-odometry=%s",
+                  "mutual-neighbours=%g mutual-neighbours-share=%g open-floor-width=%g join-passages=%s "
+                  "correct-odometry=%s",
                   toString(model).c_str(), toString(split).c_str(), match_distance, region.cell_size,
                   region.max_range, region.clearance, region.min_observations, region.band_low, region.band_high,
                   region.door_width, region.door_depth, min_group_size, ncut_threshold, boundary_passes,
-                  mutual_neighbours, mutual_neighbours_share, open_floor_width, toString(correct_odometry).c_str());
+                  mutual_neighbours, mutual_neighbours_share, open_floor_width, join_passages ? "on" : "off",
+                  toString(correct_odometry).c_str());
   }
 };
 
@@ -267,7 +274,7 @@ struct Result {
   double ari = 0.0;
   int rooms_whole = 0, rooms = 0;
   int rooms_found = 0, rooms_pure = 0;  ///< sim::scoreRooms: the measure of real logs with room labels
-  double seconds = 0.0;  ///< ObservationGrouping::compute() alone, wall time
+  double seconds = 0.0;  ///< ObservationGrouping::compute() and the passage joins, wall time
   std::size_t warnings = 0;
   std::string error;  ///< what compute() threw; the numbers are then meaningless
 };
@@ -297,9 +304,11 @@ Partition group(const std::vector<Observation<pcl::PointXYZ>>& observations, con
   params.mutual_neighbours_share = c.mutual_neighbours_share;
   params.threads = c.threads;
   params.voxel_leaf = c.voxel_leaf;
+  params.join_passages = c.join_passages;
   grouping.setParameters(params);
   Partition p = grouping.compute();
   if (warnings) *warnings = grouping.getWarnings().size();
+  joinGroupsThroughPassages(observations, params, p);  // as the command does after the grouping
   return p;
 }
 
@@ -747,7 +756,7 @@ const char* kUsage =
     "  --model points|free-space|visibility   --split mean|sign|best\n"
     "  --delta M (points)  --cell M  --range M  --clearance M  --min-observations N\n"
     "  --band-low M  --band-high M  --door-width M  --door-depth M  --min-group-size N  --ncut-threshold X  --boundary-passes N\n"
-    "  --mutual-neighbours N  --mutual-neighbours-share X  --open-floor-width M (visibility)\n"
+    "  --mutual-neighbours N  --mutual-neighbours-share X  --open-floor-width M  --join-passages on|off (visibility)\n"
     "  --threads N (0: all cores)  --voxel M (each observation's voxel leaf, as the command's --voxel)\n"
     "  --correct-odometry auto|off (auto: at the poses the command groups at, scan-matched when more consistent)\n"
     "  --depth-size WxH (the depth camera's pixels; default 80x60, the field of view kept)\n"
@@ -803,6 +812,11 @@ int main(int argc, char** argv) {
         {"--mutual-neighbours", number(configuration.mutual_neighbours)},
         {"--mutual-neighbours-share", number(configuration.mutual_neighbours_share)},
         {"--open-floor-width", number(configuration.open_floor_width)},
+        {"--join-passages",
+         [&](const std::string& flag, const std::string& v) {
+           if (v != "on" && v != "off") throw std::invalid_argument(flag + " takes on or off, not '" + v + "'");
+           configuration.join_passages = v == "on";
+         }},
         {"--threads", integer(configuration.threads)},
         {"--voxel", number(configuration.voxel_leaf)},
         {"--correct-odometry",
@@ -942,6 +956,11 @@ int main(int argc, char** argv) {
   unjoined.boundary_passes = defaults.boundary_passes;
   unjoined.open_floor_width = 0;
   configurations.push_back(unjoined);
+  // The default without joins through passages: what they change.
+  Configuration no_passages = unrefined;
+  no_passages.boundary_passes = defaults.boundary_passes;
+  no_passages.join_passages = false;
+  configurations.push_back(no_passages);
   // The default on W itself, every overlap kept: what the mutual neighbours change.
   Configuration every_overlap = unrefined;
   every_overlap.boundary_passes = defaults.boundary_passes;

@@ -31,6 +31,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -88,7 +89,7 @@ void segmentationScore(const std::map<int, std::map<int, std::size_t>>& overlap,
   recall = truth ? double(hit) / double(truth) : 0.0;
 }
 
-Score evaluate(const sim::Building& b, sim::Sensor sensor, bool drifted) {
+Score evaluate(const sim::Building& b, sim::Sensor sensor, bool drifted, bool join_passages) {
   Score s;
   s.label = b.title + "; " + sim::describe(sensor) + ", " + (drifted ? "drifted" : "exact") + " poses";
   const double height = sim::sensorHeight(sensor);
@@ -102,14 +103,19 @@ Score evaluate(const sim::Building& b, sim::Sensor sensor, bool drifted) {
   ObservationGrouping<pcl::PointXYZ> grouping;
   grouping.setKeepWorldPoints(true);
   for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
-  const Partition partition = grouping.compute();
+  Partition partition = grouping.compute();
   const WorldPoints& world = grouping.getWorldPoints();
   const ObservationRegions regions = grouping.getSensedSpaceOverlap().computeRegions(observations, world);
   std::vector<Eigen::Vector3d> sensors;
   for (const auto& o : observations) sensors.push_back(o.pose.translation() - world.origin);
   std::vector<int> ids(partition.groups.size());
   for (std::size_t g = 0; g < ids.size(); ++g) ids[g] = int(g);
-  const PlaceMap map = buildPlaceMap(regions, world, sensors, partition.groups, ids);
+  PlaceMap map = buildPlaceMap(regions, world, sensors, partition.groups, ids);
+  // As `obsgroup partition` does: groups meeting through a passage joined, their places cut again.
+  if (join_passages && !joinThroughPassages(partition, ids, map).empty()) {
+    std::iota(ids.begin(), ids.end(), 0);
+    map = buildPlaceMap(regions, world, sensors, partition.groups, ids);
+  }
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   s.places = int(map.places.size());
   s.doors = int(map.doors.size());
@@ -201,6 +207,7 @@ int main(int argc, char** argv) {
   std::vector<sim::Sensor> sensors{sim::Sensor::Laser360, sim::Sensor::Laser180, sim::Sensor::Depth};
   std::vector<bool> drift{false};  // drifted maps lie in another frame than the floor plan's rooms
   std::string output;
+  bool join_passages = true;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     const bool has_value = a + 1 < argc;
@@ -218,10 +225,14 @@ int main(int argc, char** argv) {
         }
       } else if (arg == "--output" && has_value) {
         output = argv[++a];
+      } else if (arg == "--join-passages" && has_value) {
+        const std::string v = argv[++a];
+        if (v != "on" && v != "off") throw std::invalid_argument("takes on or off, not '" + v + "'");
+        join_passages = v == "on";
       } else {
         std::cerr << "usage: " << argv[0]
                   << " [--datasets office,loop,...] [--sensors laser360,laser180,depth] [--poses exact,drift]"
-                     " [--output docs/places.md]\n";
+                     " [--join-passages on|off] [--output docs/places.md]\n";
         return 2;
       }
     } catch (const std::exception& e) {
@@ -240,7 +251,7 @@ int main(int argc, char** argv) {
     }
     for (sim::Sensor sensor : sensors)
       for (bool drifted : drift) {
-        scores.push_back(evaluate(building, sensor, drifted));
+        scores.push_back(evaluate(building, sensor, drifted, join_passages));
         const Score& s = scores.back();
         std::cout << s.label << ": " << s.places << " places, " << s.doors << " doors, precision "
                   << percent(s.precision) << ", recall " << percent(s.recall) << " (rooms " << percent(s.room_precision)

@@ -55,6 +55,7 @@ void GroupingParameters::usePaperMethod() {
   mutual_neighbours = papers.mutual_neighbours;
   mutual_neighbours_share = papers.mutual_neighbours_share;
   open_floor_width = 0.0;
+  join_passages = false;
 }
 
 void GroupingParameters::check() const {
@@ -122,7 +123,7 @@ bool operator==(const GroupingParameters& a, const GroupingParameters& b) {
          a.diagonal_weight == b.diagonal_weight && a.split == b.split && a.ncut_threshold == b.ncut_threshold &&
          a.boundary_passes == b.boundary_passes && a.mutual_neighbours == b.mutual_neighbours &&
          a.mutual_neighbours_share == b.mutual_neighbours_share && a.open_floor_width == b.open_floor_width &&
-         a.min_group_size == b.min_group_size &&
+         a.join_passages == b.join_passages && a.min_group_size == b.min_group_size &&
          a.max_depth == b.max_depth && a.eigen_solver == b.eigen_solver && a.threads == b.threads;
 }
 

@@ -701,6 +701,9 @@ TEST_F(Cli, UsageErrors) {
   EXPECT_EQ(run("partition " + input + out + " --cell 0.01 --door-width 3").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --paper --split best").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --paper --ncut-threshold 0.8").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --paper --join-passages on").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --sso points --join-passages off").code, 2);
+  EXPECT_EQ(run("partition " + input + out + " --join-passages maybe").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --band 1 0").code, 2);
   EXPECT_EQ(run("partition " + input + out + " --sso voxels").code, 2);
   // A value each option accepts alone, refused together (GroupingParameters::check): a usage error too.
@@ -1056,6 +1059,32 @@ TEST_F(Cli, FoldersHoldingOtherFilesAreNeverReplaced) {
   fs::create_directories(dir_ / ".out.obsgroup-staging-999999999" / "local_maps");
   ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "out").string()).code, 0);
   EXPECT_FALSE(fs::exists(dir_ / ".out.obsgroup-staging-999999999"));
+}
+
+TEST_F(Cli, PassagesJoinACorridorsGroupsAndOffKeepsThem) {
+  // The office log's corridor is cut across where the robot turned back:
+  // no door there, and its two groups are one place.
+  const std::string input = kData + "/office_2d/office.clf";
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures -o " + (dir_ / "on").string()).code, 0);
+  ASSERT_EQ(run("partition " + input + " -q --no-pictures --join-passages off -o " + (dir_ / "off").string()).code, 0);
+  const nlohmann::json on = readJson(dir_ / "on" / "partition.json"), off = readJson(dir_ / "off" / "partition.json");
+  const int joins = on.at("statistics").at("passage_joins").get<int>();
+  EXPECT_GE(joins, 1);
+  EXPECT_EQ(off.at("statistics").at("passage_joins"), 0);
+  EXPECT_EQ(on.at("parameters").at("join_passages"), true);
+  EXPECT_EQ(off.at("parameters").at("join_passages"), false);
+  EXPECT_EQ(on.at("groups").size() + std::size_t(joins), off.at("groups").size());
+  // Each joined group is a union of groups kept apart with the option off.
+  std::map<int, int> joined_group;
+  for (std::size_t g = 0; g < on.at("groups").size(); ++g)
+    for (int i : on.at("groups")[g]) joined_group[i] = int(g);
+  for (const auto& group : off.at("groups"))
+    for (int i : group) EXPECT_EQ(joined_group.at(i), joined_group.at(group[0].get<int>()));
+  // The place ids stay the group indices, and no door of the places lies between one place.
+  EXPECT_EQ(on.at("place_ids").size(), on.at("groups").size());
+  for (std::size_t g = 0; g < on.at("place_ids").size(); ++g) EXPECT_EQ(on.at("place_ids")[g], int(g));
+  for (const auto& door : readJson(dir_ / "on" / "places.json").at("doors"))
+    EXPECT_NE(door.at("places")[0], door.at("places")[1]);
 }
 
 TEST_F(Cli, PosesAtUtmCoordinatesAreWrittenAtFullPrecision) {

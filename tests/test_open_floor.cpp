@@ -9,6 +9,7 @@
 #include <limits>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -204,6 +205,25 @@ TEST(OpenFloor, BadArgumentsAreRefused) {
     EXPECT_THROW(joinAcrossOpenFloor(r.partition, r.positions, 4.5, kCell, occupied, bad), std::invalid_argument);
   }
   EXPECT_EQ(r.partition.groups.size(), 3u);
+}
+
+TEST(OpenFloor, JoinGroupsKeepsTheGroupsOrderedAndSaysWhereEachCameFrom) {
+  Partition p;
+  p.groups = {{0, 4}, {1, 2}, {3, 6}, {5}};
+  p.group_of = {0, 1, 1, 2, 0, 3, 2};
+  p.warnings = {"kept"};
+  const std::vector<int> first_of = joinGroups(p, {{3, 1}, {1, 3}});
+  EXPECT_EQ(p.groups, (std::vector<std::vector<int>>{{0, 4}, {1, 2, 5}, {3, 6}}));
+  EXPECT_EQ(p.group_of, (std::vector<int>{0, 1, 1, 2, 0, 1, 2}));
+  EXPECT_EQ(first_of, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(p.warnings, std::vector<std::string>{"kept"});
+  // Through a chain: the set takes the place of its first group.
+  EXPECT_EQ(joinGroups(p, {{2, 1}, {0, 2}}), std::vector<int>{0});
+  EXPECT_EQ(p.groups, (std::vector<std::vector<int>>{{0, 1, 2, 3, 4, 5, 6}}));
+  EXPECT_EQ(p.group_of, std::vector<int>(7, 0));
+  EXPECT_THROW(joinGroups(p, {{0, 1}}), std::invalid_argument);
+  EXPECT_THROW(joinGroups(p, {{-1, 0}}), std::invalid_argument);
+  EXPECT_EQ(joinGroups(p, {}), std::vector<int>{0});
 }
 
 }  // namespace

@@ -476,5 +476,114 @@ TEST(Places, LocalizeAlignsAScanToItsPlacesLocalMap) {
   EXPECT_FALSE(nowhere.converged);
 }
 
+namespace {
+
+/// A corridor 2 m wide and 12 m long, cut across at x = 6 m between places
+/// 10 (west) and 20 (east), and a room of 4 x 4 m north of it (place 30)
+/// behind a door 1.4 m wide: the cut is a passage, the door is not. The
+/// grid's lower-left corner lies at `origin`.
+PlaceMap corridorCutAndRoom(const Eigen::Vector2d& origin) {
+  PlaceMap map;
+  map.grid.resolution = 0.2;
+  map.grid.origin = origin;
+  map.grid.width = 60;
+  map.grid.height = 40;
+  const std::size_t cells = std::size_t(map.grid.width) * std::size_t(map.grid.height);
+  map.occupancy.assign(cells, Occupancy::Unknown);
+  map.labels.assign(cells, -1);
+  const auto set = [&](int i, int j, Occupancy o, int label) {
+    map.occupancy[map.grid.index(i, j)] = o;
+    map.labels[map.grid.index(i, j)] = label;
+  };
+  for (int i = 0; i < 60; ++i) {
+    set(i, 4, Occupancy::Occupied, -1);
+    for (int j = 5; j <= 14; ++j) set(i, j, Occupancy::Free, i < 30 ? 10 : 20);
+    set(i, 15, Occupancy::Occupied, -1);
+  }
+  for (int i = 19; i <= 40; ++i)
+    for (int j = 15; j <= 36; ++j) {
+      const bool wall = i == 19 || i == 40 || j == 36 || (j == 15 && !(i >= 33 && i <= 39));
+      set(i, j, wall ? Occupancy::Occupied : Occupancy::Free, wall ? -1 : 30);
+    }
+  for (int id : {10, 20, 30}) {
+    Place place;
+    place.id = id;
+    map.places.push_back(place);
+  }
+  const auto door = [&](int a, int b, Eigen::Vector2d end_a, Eigen::Vector2d end_b) {
+    Door d;
+    d.place_a = a;
+    d.place_b = b;
+    d.end_a = origin + end_a;
+    d.end_b = origin + end_b;
+    d.midpoint = (d.end_a + d.end_b) / 2;
+    d.width_m = (end_b - end_a).norm();
+    return d;
+  };
+  map.doors = {door(10, 20, {6.0, 1.0}, {6.0, 3.0}), door(20, 30, {6.6, 3.0}, {8.0, 3.0})};
+  return map;
+}
+
+}  // namespace
+
+TEST(Places, ACorridorCutAcrossIsAPassageADoorIsNot) {
+  for (const Eigen::Vector2d& origin : {Eigen::Vector2d(0, 0), Eigen::Vector2d(512345.678901, 5123456.789012)}) {
+    const PlaceMap map = corridorCutAndRoom(origin);
+    const std::vector<Door> passages = passagesOf(map);
+    ASSERT_EQ(passages.size(), 1u) << "origin " << origin.transpose();
+    EXPECT_EQ(passages[0].place_a, 10);
+    EXPECT_EQ(passages[0].place_b, 20);
+
+    Partition p;
+    p.groups = {{0, 1, 5}, {2, 3}, {4}};
+    p.group_of = {0, 0, 1, 1, 2, 0};
+    std::vector<int> ids{10, 20, 30};
+    const std::vector<Door> joined = joinThroughPassages(p, ids, map);
+    ASSERT_EQ(joined.size(), 1u);
+    EXPECT_EQ(p.groups, (std::vector<std::vector<int>>{{0, 1, 2, 3, 5}, {4}}));
+    EXPECT_EQ(p.group_of, (std::vector<int>{0, 0, 0, 0, 1, 0}));
+    EXPECT_EQ(ids, (std::vector<int>{10, 30}));
+  }
+  // The room's door almost as wide as the corridor is still a door: the free
+  // space widens on both of its sides.
+  PlaceMap wide = corridorCutAndRoom(Eigen::Vector2d::Zero());
+  for (int i = 31; i <= 39; ++i) wide.occupancy[wide.grid.index(i, 15)] = Occupancy::Free;
+  wide.doors[1].end_a = {6.2, 3.0};
+  wide.doors[1].midpoint = (wide.doors[1].end_a + wide.doors[1].end_b) / 2;
+  wide.doors[1].width_m = 1.8;
+  EXPECT_EQ(passagesOf(wide).size(), 1u);
+  // A corridor as narrow as a door is a door.
+  PlaceMap narrow = corridorCutAndRoom(Eigen::Vector2d::Zero());
+  for (int i = 0; i < 60; ++i)
+    for (int j = 5; j <= 9; ++j) narrow.occupancy[narrow.grid.index(i, j)] = Occupancy::Occupied;
+  EXPECT_TRUE(passagesOf(narrow).empty());
+  std::vector<int> wrong{10, 20};
+  Partition p;
+  p.groups = {{0}, {1}, {2}};
+  p.group_of = {0, 1, 2};
+  EXPECT_THROW(joinThroughPassages(p, wrong, narrow), std::invalid_argument);
+}
+
+TEST(Places, TheCommandsStepJoinsOneGroupPerPassageItReportsAndNothingWhenOff) {
+  // (Cli.PassagesJoinACorridorsGroups: a real corridor cut across is joined.)
+  const sim::Building building = sim::makeBuilding("office");
+  const std::vector<Observation<pcl::PointXYZ>> observations =
+      test::simulate<pcl::PointXYZ>(building.plan, building.route, sim::laser360());
+  ObservationGrouping<pcl::PointXYZ> grouping;
+  for (const auto& o : observations) grouping.addObservation(o.cloud, o.pose);
+  const Partition before = grouping.compute();
+  Partition after = before;
+  const std::vector<Door> joined = joinGroupsThroughPassages(observations, grouping.getParameters(), after);
+  EXPECT_EQ(after.groups.size() + joined.size(), before.groups.size());
+  for (const Door& passage : joined)
+    EXPECT_EQ(after.group_of[std::size_t(before.groups[std::size_t(passage.place_a)][0])],
+              after.group_of[std::size_t(before.groups[std::size_t(passage.place_b)][0])]);
+  GroupingParameters off = grouping.getParameters();
+  off.join_passages = false;
+  Partition untouched = before;
+  EXPECT_TRUE(joinGroupsThroughPassages(observations, off, untouched).empty());
+  EXPECT_EQ(untouched.groups, before.groups);
+}
+
 }  // namespace
 }  // namespace obsgroup

@@ -68,6 +68,11 @@ struct GroupingParameters {
   /// into bands, is one place again; doors and corridors are narrower.
   /// 0: no joins (the paper's).
   double open_floor_width = 4.5;
+  /// Visibility model: groups whose places meet through a passage (a
+  /// corridor cut across, not a door) are joined. compute() gives the groups
+  /// before; joinGroupsThroughPassages() (observation_grouping.h), which the
+  /// command runs after it, joins them. false: none (the paper's).
+  bool join_passages = true;
   /// A bisection giving a group smaller than this is rejected.
   int min_group_size = 1;
   /// Bisections deeper than this are not attempted.

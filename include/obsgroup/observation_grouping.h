@@ -9,6 +9,7 @@
 #include "obsgroup/overlap/sensed_space_overlap.h"
 #include "obsgroup/partition/open_floor.h"
 #include "obsgroup/partition/recursive_partitioner.h"
+#include "obsgroup/places/place_map.h"
 
 #include <functional>
 #include <memory>
@@ -204,6 +205,18 @@ class ObservationGrouping {
   std::vector<std::string> warnings_;
   std::vector<OpenFloorJoin> open_floor_joins_;
 };
+
+/// The step `obsgroup partition` and `stream` take after the grouping, with
+/// the visibility model and params.join_passages (else it does nothing):
+/// the places of `partition` (buildPlaceMap over the visibility regions of
+/// `observations`, as the grouping measured them) and the groups whose
+/// places meet through a passage, a corridor cut across rather than a door,
+/// joined (joinThroughPassages; docs/method.md, "Passages"). Returns the
+/// passages that joined two groups, their places named by the indices of
+/// the groups before the join. Throws what buildPlaceMap throws.
+template <typename PointT>
+std::vector<Door> joinGroupsThroughPassages(const std::vector<Observation<PointT>>& observations,
+                                            const GroupingParameters& params, Partition& partition);
 
 }  // namespace obsgroup
 

@@ -75,12 +75,13 @@ _READER_OPTIONS = {
 _METHOD_OPTIONS = {
     "sso", "model", "paper", "cell", "range", "clearance", "min_observations", "band", "door_width", "door_depth",
     "delta", "voxel", "ncut_threshold", "boundary_passes", "mutual_neighbours", "mutual_neighbours_share", "split",
-    "open_floor_width", "min_group_size", "max_depth", "threads",
+    "open_floor_width", "join_passages", "min_group_size", "max_depth", "threads",
 }
 _COMMAND_OPTIONS = _READER_OPTIONS | _METHOD_OPTIONS | {
     "keyframes", "refine", "map_voxel", "force", "quiet", "no_pictures",
 }
 _FLAGS = {"skip_bad_lines", "skip_bad_files", "paper", "force", "quiet", "no_pictures"}
+_SWITCHES = {"join_passages"}  # True or False, given to the command as on or off
 _COMMA_LISTS = {"intrinsics", "keyframes"}  # one argument "a,b,c"; band is two arguments
 _ALIASES = {"model": "sso"}
 
@@ -101,10 +102,12 @@ def _words(options: Dict[str, Any], allowed: set, where: str) -> List[str]:
         if value is None:
             continue
         option = "--" + _ALIASES.get(name, name).replace("_", "-")
-        if name in _FLAGS:
+        if name in _FLAGS or name in _SWITCHES:
             if not isinstance(value, (bool, np.bool_)):
                 raise TypeError(f"{name}= is True or False, not {value!r}")
-            if value:
+            if name in _SWITCHES:
+                words += [option, "on" if value else "off"]
+            elif value:
                 words.append(option)
             continue
         if isinstance(value, (list, tuple, np.ndarray)):
@@ -267,8 +270,9 @@ class Grouping:
     Keyword arguments are the command's method options: ``model=`` (``"visibility"``,
     ``"free-space"``, ``"points"``), ``cell=``, ``range=``, ``clearance=``, ``min_observations=``,
     ``band=(low, high)``, ``door_width=``, ``door_depth=``, ``delta=``, ``voxel=``, ``split=``, ``ncut_threshold=``,
-    ``boundary_passes=``, ``mutual_neighbours=``, ``mutual_neighbours_share=``, ``open_floor_width=``, ``min_group_size=``,
-    ``max_depth=``, ``paper=True``, ``threads=``.
+    ``boundary_passes=``, ``mutual_neighbours=``, ``mutual_neighbours_share=``, ``open_floor_width=``,
+    ``join_passages=`` (``True``: groups whose places meet through a passage, a corridor cut across, are
+    joined, as the command does), ``min_group_size=``, ``max_depth=``, ``paper=True``, ``threads=``.
     Their defaults are the command's; a bad value raises :class:`UsageError`.
     """
 
@@ -356,7 +360,8 @@ class OnlineGrouping:
 
     @property
     def groups(self) -> Dict[int, List[int]]:
-        """Place id -> its observation ids, ascending."""
+        """Place id -> its observation ids, ascending: the groups each update keeps, before
+        :attr:`partition` joins those that meet through a passage (``join_passages=``)."""
         return dict(self._native.groups())
 
     def place_of(self, id: int) -> int:
@@ -369,7 +374,9 @@ class OnlineGrouping:
         return self._native.ids()
 
     def partition(self) -> Partition:
-        """The last update's partition, over the present observations in id order."""
+        """The last update's partition, over the present observations in id order, with the groups
+        whose places meet through a passage joined as :meth:`Grouping.compute` and the command join
+        them (``join_passages=``)."""
         return Partition(self._native.partition())
 
 

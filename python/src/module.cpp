@@ -393,7 +393,14 @@ class PyGrouping {
     ProgressRelay progress(callback, interrupt_);
     grouping_.setProgressCallback([&progress](std::size_t done, std::size_t total) { progress("overlap", done, total); });
     PyPartition result;
-    result.partition = runReleased([this] { return grouping_.compute(); }, interrupt_, &progress);
+    result.partition = runReleased(
+        [this] {
+          Partition partition = grouping_.compute();
+          // As the command does after the grouping.
+          joinGroupsThroughPassages(grouping_.getObservations(), grouping_.getParameters(), partition);
+          return partition;
+        },
+        interrupt_, &progress);
     grouping_.setProgressCallback({});
     result.W = grouping_.getWeightMatrix();
     result.warnings = grouping_.getWarnings();
@@ -460,7 +467,13 @@ class PyOnlineGrouping {
   std::map<int, std::vector<int>> groups() const { return online_.getGroups(); }
   int groupOf(int id) const { return online_.getGroupOf(id); }
   std::vector<int> ids() const { return online_.getIds(); }
-  PyPartition partition() const { return {online_.getPartition(), online_.getWeightMatrix(), online_.getWarnings()}; }
+  /// The groups after the last update, with those whose places meet through
+  /// a passage joined, as the command and Grouping.compute() give them.
+  PyPartition partition() const {
+    Partition partition = online_.getPartition();
+    joinGroupsThroughPassages(online_.getObservations(), online_.getParameters(), partition);
+    return {partition, online_.getWeightMatrix(), online_.getWarnings()};
+  }
 
  private:
   cli::PartitionArgs args_;

@@ -27,8 +27,9 @@ def test_online_grouping_equals_the_batch_after_every_exact_update(data):
             changes = online.update()
             assert all(isinstance(c, obsgroup.Change) for c in changes)
             created |= {c.place for c in changes if c.kind == "created"}
-            groups = sorted(online.groups.values())
-            assert groups == sorted(batch_groups(scans[: k + 1]))
+            groups = sorted(online.groups.values())  # each update's groups: before the passages join some
+            assert groups == sorted(batch_groups(scans[: k + 1], join_passages=False))
+            assert online.partition().groups == batch_groups(scans[: k + 1])
     assert set(online.groups) <= created | {c for c in online.groups}
     assert all(online.place_of(i) in online.groups for i in range(len(scans)))
 
@@ -48,8 +49,9 @@ def test_online_updates_poses_and_removals(data):
     assert 10 not in online.ids and all(10 not in m for m in online.groups.values())
     kept = [obsgroup.Observation(s.points, moved if i == 20 else s.pose) for i, s in enumerate(scans) if i != 10]
     ids = [i for i in range(len(scans)) if i != 10]
-    expected = sorted([ids[k] for k in g] for g in batch_groups(kept))
+    expected = sorted([ids[k] for k in g] for g in batch_groups(kept, join_passages=False))
     assert sorted(online.groups.values()) == expected
+    assert online.partition().groups == batch_groups(kept)
     with pytest.raises(IndexError, match="no observation 10"):
         online.update_pose(10, np.eye(4))  # removed
 

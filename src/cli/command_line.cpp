@@ -270,6 +270,11 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->check(finiteNumber(0.0, false, 1000.0))
       ->capture_default_str()
       ->group("Partition");
+  command.add_option("--join-passages", args.method.join_passages,
+                     "visibility model: join two groups whose places meet through a passage, a corridor or a room "
+                     "cut across where it goes on as narrow, not a door (on/off; off with --paper)")
+      ->capture_default_str()
+      ->group("Partition");
   command.add_option("--split", args.method.split,
                      "how the eigenvector is cut: best (smallest Ncut), mean (the paper's) or sign (default: " +
                          toString(args.method.split) + ")")
@@ -524,6 +529,8 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
       return "--paper joins no groups (--open-floor-width 0); drop one of them";
     if (partition.count("--correct-odometry") && args.correct_odometry != obsgroup::OdometryCorrection::Off)
       return "--paper groups at the input poses (--correct-odometry off); drop one of them";
+    if (partition.count("--join-passages") && args.method.join_passages)
+      return "--paper joins no groups (--join-passages off); drop one of them";
     args.method.usePaperMethod();
     args.correct_odometry = obsgroup::OdometryCorrection::Off;
   }
@@ -537,7 +544,8 @@ std::optional<std::string> settleOptions(const CLI::App& partition, obsgroup::cl
   if (!points && partition.count("--delta")) return "--delta applies to --sso points (the region models use --cell)";
   if (args.method.model != SensedSpaceModel::Visibility)
     for (const char* option :
-         {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth", "--open-floor-width"})
+         {"--clearance", "--min-observations", "--band", "--door-width", "--door-depth", "--open-floor-width",
+          "--join-passages"})
       if (partition.count(option)) return std::string(option) + " applies to --sso visibility only";
   if (args.voxel) args.method.voxel_leaf = *args.voxel;
   if (!args.band.empty()) {

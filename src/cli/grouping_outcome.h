@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <future>
+#include <optional>
 #include <vector>
 
 namespace obsgroup::cli {
@@ -38,6 +39,15 @@ struct GroupingOutcome {
   nlohmann::json timing_s = nlohmann::json::object();
   /// What partition.json records of the mode besides the method's parameters.
   nlohmann::json parameters = nlohmann::json::object();
+
+  /// The places' floor evidence, once taken from `floor` or made (the places
+  /// are cut twice when passages join groups).
+  std::optional<FloorEvidence> floor_evidence;
+  /// The regions the places read when the grouping kept none (stream, points model).
+  ObservationRegions computed_regions;
+  /// The places of `partition`, made before the local maps when passages
+  /// may join groups; else made with the outputs.
+  std::optional<PlaceMap> places;
 
   /// The places' pass over every beam (observeFloor), made on a thread of
   /// its own while a batch run partitions; not valid otherwise. Last, so

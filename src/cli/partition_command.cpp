@@ -335,6 +335,7 @@ nlohmann::json methodParameters(const GroupingParameters& method, const Partitio
       p["door_width"] = method.regions.door_width;
       p["door_depth"] = method.regions.door_depth;
       p["open_floor_width"] = method.open_floor_width;
+      p["join_passages"] = method.join_passages;
     }
   }
   p["voxel"] = method.voxel_leaf;
@@ -370,6 +371,97 @@ ObservationRegions regionsOfRun(const PartitionArgs& args, const GroupingOutcome
     return grouped.grouping.getSensedSpaceOverlap().computeRegions(observations, grouped.world());
   return computeRegions(SensedSpaceModel::Visibility, grouped.world(), sensorOrigins(observations, grouped.world()),
                         RegionParameters{}, args.method.threads, args.interrupt);
+}
+
+/// The regions the places read: the grouping's own when it kept them
+/// (partition), else computed once (stream, points model).
+template <typename PointT>
+const ObservationRegions& regionsForPlaces(const PartitionArgs& args, GroupingOutcome<PointT>& grouped,
+                                          const std::vector<Observation<PointT>>& observations) {
+  const ObservationRegions& kept = grouped.grouping.getRegions();
+  if (kept.size() == int(observations.size())) return kept;
+  if (grouped.computed_regions.size() != int(observations.size())) {
+    if (grouped.world_points.size() != int(observations.size()))
+      grouped.world_points = grouped.grouping.getSensedSpaceOverlap().toWorld(observations);
+    grouped.computed_regions = regionsOfRun(args, grouped, observations);
+  }
+  return grouped.computed_regions;
+}
+
+/// The places of the run's groups (grouped.partition, grouped.place_ids):
+/// those made before the local maps when they stand, else cut now. The
+/// pass over the beams is made once (or taken from the partition's thread).
+/// Throws std::invalid_argument as buildPlaceMap does.
+template <typename PointT>
+PlaceMap placesOfRun(const PartitionArgs& args, GroupingOutcome<PointT>& grouped,
+                     const std::vector<Observation<PointT>>& observations) {
+  if (grouped.places) {
+    PlaceMap made = std::move(*grouped.places);
+    grouped.places.reset();
+    return made;
+  }
+  const ObservationRegions& regions = regionsForPlaces(args, grouped, observations);
+  const PlaceOptions options = placeOptions(args);
+  const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
+  if (!grouped.floor_evidence) {
+    if (grouped.floor.valid()) {  // the pass over the beams, made while the partition ran
+      grouped.floor_evidence = grouped.floor.get();
+    } else if (grouped.world_points.size() == int(observations.size())) {
+      const WorldPoints& world = grouped.world();
+      const PlacePointSource points_of = [&world](int i, std::vector<Eigen::Vector3f>&) {
+        return std::make_pair(world.begin(i), world.end(i));
+      };
+      grouped.floor_evidence = observeFloor(regions, world.origin, points_of, sensorOrigins(observations, world),
+                                            options, args.method.threads, args.interrupt);
+    } else {
+      const auto& sso = grouped.grouping.getSensedSpaceOverlap();
+      grouped.floor_evidence = observeFloor(regions, origin, pointsOnDemand(sso, observations, origin),
+                                            sensorOrigins(observations, origin), options, args.method.threads,
+                                            args.interrupt);
+    }
+  }
+  return buildPlaceMap(regions, *grouped.floor_evidence, sensorOrigins(observations, origin),
+                       grouped.partition.groups, grouped.place_ids, options);
+}
+
+/// Joins the groups whose places meet through a passage (a corridor cut
+/// across, not a door: joinThroughPassages), before the local maps are made
+/// of them; the places of the joined groups are cut again. Visibility model
+/// only. Places that cannot be cut join nothing (the outputs say why).
+template <typename PointT>
+void joinPassages(const PartitionArgs& args, GroupingOutcome<PointT>& grouped,
+                  const std::vector<Observation<PointT>>& observations) {
+  grouped.statistics["passage_joins"] = 0;
+  if (!args.method.join_passages || args.method.model != SensedSpaceModel::Visibility || observations.empty()) return;
+  const auto start = Clock::now();
+  try {
+    PlaceMap places = placesOfRun(args, grouped, observations);
+    std::vector<int> before(grouped.partition.group_of.size());  // each observation's place id
+    for (std::size_t g = 0; g < grouped.partition.groups.size(); ++g)
+      for (int i : grouped.partition.groups[g]) before[std::size_t(i)] = grouped.place_ids[g];
+    const std::vector<Door> joined = joinThroughPassages(grouped.partition, grouped.place_ids, places);
+    grouped.statistics["passage_joins"] = joined.size();
+    if (joined.empty()) {
+      grouped.places = std::move(places);
+    } else {
+      if (grouped.online) {
+        // Each observation's last line gives its place in the results.
+        std::unordered_map<int, int> joined_into;  // place id before -> after
+        for (std::size_t g = 0; g < grouped.partition.groups.size(); ++g)
+          for (int i : grouped.partition.groups[g]) joined_into[before[std::size_t(i)]] = grouped.place_ids[g];
+        for (std::size_t i = 0; i < before.size(); ++i)
+          if (joined_into.at(before[i]) != before[i] && !args.quiet)
+            std::printf("observation %zu: place %d (joined through a passage)\n", i, joined_into.at(before[i]));
+        std::fflush(stdout);
+      } else {
+        std::iota(grouped.place_ids.begin(), grouped.place_ids.end(), 0);  // a batch run's place ids are its group indices
+      }
+      grouped.places = placesOfRun(args, grouped, observations);
+    }
+  } catch (const std::invalid_argument&) {
+    grouped.places.reset();  // writeResults tries again and says why
+  }
+  grouped.timing_s["passages"] = secondsSince(start);
 }
 
 /// places.json/.geojson, the label map and the occupancy map; with more
@@ -427,40 +519,17 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   const auto places_start = Clock::now();
   ProgressBar bar("places", !args.quiet, args.progress);
   bar(0, 2);
-  const SensedSpaceOverlap<PointT>& sso = grouped.grouping.getSensedSpaceOverlap();
-  // The grouping's own regions when it kept them (partition); computed here otherwise (stream, points model).
-  const ObservationRegions& kept = grouped.grouping.getRegions();
-  const bool regions_kept = kept.size() == int(observations.size());
-  // Every observation's world points at once only for what reads them so:
-  // regions computed here and the pictures. The places alone ask for each
-  // observation's in turn (100,100 scans: about 430 MiB less at the peak).
-  const bool world_needed = !regions_kept || args.pictures;
-  if (world_needed && grouped.world_points.size() != int(observations.size())) grouped.world_points = sso.toWorld(observations);
-  ObservationRegions computed;
-  if (!regions_kept) computed = regionsOfRun(args, grouped, observations);
-  const ObservationRegions& regions = regions_kept ? kept : computed;
+  if (args.pictures && grouped.world_points.size() != int(observations.size()))
+    grouped.world_points = grouped.grouping.getSensedSpaceOverlap().toWorld(observations);
   bar(1, 2);
-  const PlaceOptions place_options = placeOptions(args);
   std::optional<PlaceMap> places;
   try {
-    if (grouped.floor.valid()) {  // the pass over the beams, made while the partition ran
-      const FloorEvidence floor = grouped.floor.get();
-      const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
-      places = buildPlaceMap(regions, floor, sensorOrigins(observations, origin), grouped.partition.groups,
-                             grouped.place_ids, place_options);
-    } else if (grouped.world_points.size() == int(observations.size())) {
-      places = buildPlaceMap(regions, grouped.world(), sensorOrigins(observations, grouped.world()),
-                             grouped.partition.groups, grouped.place_ids, place_options);
-    } else {
-      const Eigen::Vector3d origin = SensedSpaceOverlap<PointT>::worldOrigin(observations);
-      places = buildPlaceMap(regions, origin, pointsOnDemand(sso, observations, origin),
-                             sensorOrigins(observations, origin), grouped.partition.groups, grouped.place_ids,
-                             place_options);
-    }
+    places = placesOfRun(args, grouped, observations);
   } catch (const std::invalid_argument& e) {
     // The groups and local maps stand without them.
     warn(std::string("places not written: ") + e.what());
   }
+  grouped.floor_evidence.reset();
   returnFreedMemory(kTrimBytes);
   if (places) {
     PlaceMap written = *places;  // with keyframes, each place's members are all the frames of its keyframes
@@ -478,9 +547,11 @@ OutputTimes writeResults(const PartitionArgs& args, const io::OutputFolder& out,
   if (topology_written.valid()) topology_written.get();  // rethrows what writing them threw
   if (args.pictures) {
     const auto pictures_start = Clock::now();
-    drawPictures(args, out, grouped, observations, maps, regions, places ? &*places : nullptr);
+    drawPictures(args, out, grouped, observations, maps, regionsForPlaces(args, grouped, observations),
+                 places ? &*places : nullptr);
     t.pictures_s = secondsSince(pictures_start);
   }
+  grouped.computed_regions = ObservationRegions{};
   grouped.world_points = WorldPoints{};  // nothing after needs them
   returnFreedMemory(kTrimBytes);
   t.outputs_s = secondsSince(start);
@@ -889,6 +960,7 @@ int runPipeline(const PartitionArgs& args, std::vector<Observation<PointT>> obse
   else
     groupObservations(args, observations, input, grouped);
   warnAboutGrouping(observations, input, grouped, warn);
+  joinPassages(args, grouped, observations);
   returnFreedMemory(kTrimBytes);  // the partition's matrices, many below malloc's own threshold for returning them
   MapsOfRun<PointT> maps = buildMaps(args, observations, grouped.partition, grouped.weights(), warn);
   returnFreedMemory(kTrimBytes);

@@ -134,6 +134,38 @@ class NearPositions {
 
 }  // namespace
 
+std::vector<int> joinGroups(Partition& partition, const std::vector<std::pair<int, int>>& pairs) {
+  const int count = int(partition.groups.size());
+  UnionFind sets(count);
+  for (const auto& [a, b] : pairs) {
+    if (a < 0 || b < 0 || a >= count || b >= count)
+      throw std::invalid_argument("joinGroups: the pair (" + std::to_string(a) + ", " + std::to_string(b) +
+                                  ") names a group beyond the " + std::to_string(count) + " there are");
+    sets.join(a, b);
+  }
+  // Each set's members, in the order of its first group (the groups are
+  // ordered by their first observation, so the union is too).
+  std::vector<std::vector<int>> merged;
+  std::vector<int> first_of;
+  std::vector<int> index_of_root(std::size_t(count), -1);
+  for (int g = 0; g < count; ++g) {
+    const int root = sets.find(g);
+    if (index_of_root[std::size_t(root)] < 0) {
+      index_of_root[std::size_t(root)] = int(merged.size());
+      merged.emplace_back();
+      first_of.push_back(g);
+    }
+    auto& members = merged[std::size_t(index_of_root[std::size_t(root)])];
+    members.insert(members.end(), partition.groups[std::size_t(g)].begin(), partition.groups[std::size_t(g)].end());
+  }
+  if (int(merged.size()) == count) return first_of;
+  for (auto& members : merged) std::sort(members.begin(), members.end());
+  partition.groups = std::move(merged);
+  for (int g = 0; g < int(partition.groups.size()); ++g)
+    for (int i : partition.groups[std::size_t(g)]) partition.group_of[std::size_t(i)] = g;
+  return first_of;
+}
+
 double narrowestChord(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cell, double cap,
                       const OccupiedAt& occupied) {
   return walkChords(a, b, cell, cap, 0.0, occupied);
@@ -211,23 +243,9 @@ std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::
   for (const auto& [pair, chord] : narrowest)
     if (chord >= width && sets.join(pair.first, pair.second)) joins.push_back({pair.first, pair.second, chord});
   if (joins.empty()) return joins;
-  // Each set's members, in the order of its first group (the groups are
-  // ordered by their first observation, so the union is too).
-  std::vector<std::vector<int>> merged;
-  std::vector<int> index_of_root(partition.groups.size(), -1);
-  for (int g = 0; g < int(partition.groups.size()); ++g) {
-    const int root = sets.find(g);
-    if (index_of_root[std::size_t(root)] < 0) {
-      index_of_root[std::size_t(root)] = int(merged.size());
-      merged.emplace_back();
-    }
-    auto& members = merged[std::size_t(index_of_root[std::size_t(root)])];
-    members.insert(members.end(), partition.groups[std::size_t(g)].begin(), partition.groups[std::size_t(g)].end());
-  }
-  for (auto& members : merged) std::sort(members.begin(), members.end());
-  partition.groups = std::move(merged);
-  for (int g = 0; g < int(partition.groups.size()); ++g)
-    for (int i : partition.groups[std::size_t(g)]) partition.group_of[std::size_t(i)] = g;
+  std::vector<std::pair<int, int>> pairs;
+  for (const OpenFloorJoin& join : joins) pairs.emplace_back(join.first, join.second);
+  joinGroups(partition, pairs);
   return joins;
 }
 

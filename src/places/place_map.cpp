@@ -1,6 +1,7 @@
 #include "obsgroup/places/place_map.h"
 
 #include "obsgroup/common/parallel_for.h"
+#include "obsgroup/partition/open_floor.h"
 #include "../overlap/region_cells.h"
 
 #include <Eigen/Eigenvalues>
@@ -18,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 namespace obsgroup {
@@ -972,5 +974,96 @@ PlaceMap placesFrom(const ObservationRegions& regions, const GridFrame& f, std::
 }
 
 }  // namespace
+
+namespace {
+
+/// Whether the grid cell holding `q` (in cells from the grid's origin) is free.
+bool freeCell(const PlaceMap& map, const Eigen::Vector2d& q) {
+  const double i = std::floor(q.x()), j = std::floor(q.y());
+  if (!(i >= 0 && j >= 0 && i < map.grid.width && j < map.grid.height)) return false;  // also NaN
+  return map.occupancy[map.grid.index(int(i), int(j))] == Occupancy::Free;
+}
+
+/// The free run from `q` along `direction` (unit), in half-cell steps up to
+/// `cap`, all in cells: it ends at the first cell that is not free
+/// (occupied, unknown, or off the grid).
+double freeRunOn(const PlaceMap& map, const Eigen::Vector2d& q, const Eigen::Vector2d& direction, double cap) {
+  for (double s = 0.0; s < cap; s += 0.5)
+    if (!freeCell(map, q + s * direction)) return s;
+  return cap;
+}
+
+/// Free space along a chord is measured up to this on each side, metres.
+constexpr double kPassageCap = 6.0;
+
+bool isPassage(const PlaceMap& map, const Door& contact) {
+  // In cells from the grid's origin, the ends on a grid of 1/16 cell: the
+  // same lines wherever the map lies (at UTM coordinates the world frame's
+  // last bits would move a line lying on a cell edge into the next cell).
+  const double res = map.grid.resolution;
+  const auto local = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d(((p - map.grid.origin) / res * 16.0).array().round() / 16.0);
+  };
+  const Eigen::Vector2d a = local(contact.end_a), b = local(contact.end_b);
+  if (!((b - a).norm() > 0.0)) return false;
+  const Eigen::Vector2d d = (b - a).normalized(), normal(-d.y(), d.x()), middle = (a + b) / 2;
+  const double cap = kPassageCap / res;
+  const auto chord = [&](const Eigen::Vector2d& q) { return res * (freeRunOn(map, q, d, cap) + freeRunOn(map, q, -d, cap)); };
+  const double opening = chord(middle);
+  if (opening < kMinPassageWidth || contact.width_m < 0.75 * opening) return false;
+  // One side is enough: a corridor cut where it meets another, or turns, is
+  // narrow on its own side alone (docs/method.md, "Passages").
+  for (const double side : {1.0, -1.0}) {
+    std::vector<double> widths;
+    for (int k = 0; k <= 6; ++k) {
+      const Eigen::Vector2d q = middle + side * (0.4 + 0.2 * k) / res * normal;
+      if (freeCell(map, q)) widths.push_back(chord(q));
+    }
+    if (widths.empty()) continue;  // a wall right behind the contact: no side to judge
+    // The lower median: a door along a corridor beside one line does not widen it.
+    std::nth_element(widths.begin(), widths.begin() + (widths.size() - 1) / 2, widths.end());
+    if (widths[(widths.size() - 1) / 2] < kDoorWidening * opening) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<Door> passagesOf(const PlaceMap& map) {
+  std::vector<Door> passages;
+  for (const Door& contact : map.doors)
+    if (isPassage(map, contact)) passages.push_back(contact);
+  return passages;
+}
+
+std::vector<Door> joinThroughPassages(Partition& partition, std::vector<int>& place_ids, const PlaceMap& map) {
+  if (place_ids.size() != partition.groups.size())
+    throw std::invalid_argument("joinThroughPassages: one place id per group expected");
+  std::unordered_map<int, int> group_of_place;
+  for (std::size_t g = 0; g < place_ids.size(); ++g) group_of_place.emplace(place_ids[g], int(g));
+  std::vector<Door> joined;
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<int> set_of(place_ids.size());
+  std::iota(set_of.begin(), set_of.end(), 0);
+  const auto root = [&set_of](int g) {
+    while (set_of[std::size_t(g)] != g) g = set_of[std::size_t(g)] = set_of[std::size_t(set_of[std::size_t(g)])];
+    return g;
+  };
+  for (const Door& passage : passagesOf(map)) {
+    const auto a = group_of_place.find(passage.place_a), b = group_of_place.find(passage.place_b);
+    if (a == group_of_place.end() || b == group_of_place.end()) continue;
+    const int ra = root(a->second), rb = root(b->second);
+    if (ra == rb) continue;
+    set_of[std::size_t(std::max(ra, rb))] = std::min(ra, rb);
+    pairs.emplace_back(a->second, b->second);
+    joined.push_back(passage);
+  }
+  if (pairs.empty()) return joined;
+  const std::vector<int> first_of = joinGroups(partition, pairs);
+  std::vector<int> ids;
+  for (int g : first_of) ids.push_back(place_ids[std::size_t(g)]);
+  place_ids = std::move(ids);
+  return joined;
+}
 
 }  // namespace obsgroup

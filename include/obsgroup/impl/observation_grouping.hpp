@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 namespace obsgroup {
@@ -100,6 +101,28 @@ Partition ObservationGrouping<PointT>::compute() {
   return partition;
 }
 
+template <typename PointT>
+std::vector<Door> joinGroupsThroughPassages(const std::vector<Observation<PointT>>& observations,
+                                            const GroupingParameters& params, Partition& partition) {
+  if (params.model != SensedSpaceModel::Visibility || !params.join_passages || observations.empty()) return {};
+  const SensedSpaceOverlap<PointT> overlap = sensedSpaceOverlapOf<PointT>(params);
+  const WorldPoints world = overlap.toWorld(observations);
+  const ObservationRegions regions = overlap.computeRegions(observations, world);
+  std::vector<Eigen::Vector3d> sensors;
+  sensors.reserve(observations.size());
+  for (const auto& o : observations) sensors.push_back(o.pose.translation() - world.origin);
+  PlaceOptions options;
+  options.band_low = params.regions.band_low;
+  options.band_high = params.regions.band_high;
+  std::vector<int> place_ids(partition.groups.size());
+  std::iota(place_ids.begin(), place_ids.end(), 0);
+  return joinThroughPassages(partition, place_ids,
+                             buildPlaceMap(regions, world, sensors, partition.groups, place_ids, options));
+}
+
 }  // namespace obsgroup
 
-#define PCL_INSTANTIATE_ObservationGrouping(T) template class obsgroup::ObservationGrouping<T>;
+#define PCL_INSTANTIATE_ObservationGrouping(T)                                                              \
+  template class obsgroup::ObservationGrouping<T>;                                                           \
+  template std::vector<obsgroup::Door> obsgroup::joinGroupsThroughPassages<T>(                               \
+      const std::vector<obsgroup::Observation<T>>&, const obsgroup::GroupingParameters&, obsgroup::Partition&);

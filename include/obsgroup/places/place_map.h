@@ -9,6 +9,7 @@
 #include "obsgroup/common/interrupt.h"
 #include "obsgroup/overlap/sensed_regions.h"
 #include "obsgroup/overlap/world_points.h"
+#include "obsgroup/partition/recursive_partitioner.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -186,5 +187,30 @@ PlaceMap buildPlaceMap(const ObservationRegions& regions, const FloorEvidence& f
                        const std::vector<Eigen::Vector3d>& sensor_origins,
                        const std::vector<std::vector<int>>& groups, const std::vector<int>& place_ids,
                        const PlaceOptions& options = {});
+
+/// An opening narrower than this is a door whatever lies beyond it, metres
+/// (docs/method.md, "Passages").
+constexpr double kMinPassageWidth = 1.2;
+/// A door opens into free space at least this many times as wide as itself,
+/// along the opening, on both of its sides (docs/method.md, "Passages").
+constexpr double kDoorWidening = 1.5;
+
+/// The doors of `map` (contacts up to PlaceOptions::max_door_width) that are
+/// no door but a passage: a corridor cut across. The opening (the free run
+/// through the contact's midpoint along it, on `map.occupancy`) is at least
+/// kMinPassageWidth wide, the contact spans three quarters of it or more,
+/// and on at least one side the free space along the opening, 0.4 to 1.6 m
+/// from it (the lower median of seven lines), is less than kDoorWidening
+/// times the opening: the corridor goes on as narrow there, where a door
+/// opens into a corridor or a room on both sides.
+std::vector<Door> passagesOf(const PlaceMap& map);
+
+/// Joins the groups of `partition` whose places (`place_ids`, one per group,
+/// as `map` was built with) meet through a passage (passagesOf(map)), as
+/// joinGroups does. `place_ids` becomes one per joined group: the id of its
+/// first group. Returns the passages that joined two groups not already
+/// joined, in passagesOf's order. Throws std::invalid_argument when
+/// place_ids is not one per group.
+std::vector<Door> joinThroughPassages(Partition& partition, std::vector<int>& place_ids, const PlaceMap& map);
 
 }  // namespace obsgroup
