@@ -271,9 +271,10 @@ void addMethodOptions(CLI::App& command, obsgroup::cli::PartitionArgs& args) {
       ->capture_default_str()
       ->group("Partition");
   command.add_option("--join-passages", args.method.join_passages,
-                     "visibility model: join two groups whose places meet through a passage, a corridor or a room "
-                     "cut across where it goes on as narrow, not a door (on/off; off with --paper)")
-      ->capture_default_str()
+                     "visibility model: join two groups whose places meet through a passage, a corridor cut "
+                     "across where it goes on as narrow, not a door (default: on; off with --paper)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->option_text("on|off")
       ->group("Partition");
   command.add_option("--split", args.method.split,
                      "how the eigenvector is cut: best (smallest Ncut), mean (the paper's) or sign (default: " +
