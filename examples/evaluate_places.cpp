@@ -4,7 +4,7 @@
 //
 //   evaluate_places [--datasets office,loop,rooms20,smallrooms,hall]
 //                   [--sensors laser360,laser180,depth] [--poses exact,drift]
-//                   [--output docs/places.md]
+//                   [--join-passages on|off] [--output docs/places.md]
 //
 // Label map: for each true room the place holding most of its floor cells
 // (its best match); precision = sum of the overlaps / sum of the best

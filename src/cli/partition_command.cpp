@@ -461,6 +461,7 @@ void joinPassages(const PartitionArgs& args, GroupingOutcome<PointT>& grouped,
   } catch (const std::invalid_argument&) {
     grouped.places.reset();  // writeResults tries again and says why
   }
+  grouped.floor_evidence.reset();  // in the places now: not held through the local maps
   grouped.timing_s["passages"] = secondsSince(start);
 }
 
