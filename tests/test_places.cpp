@@ -565,8 +565,11 @@ TEST(Places, ACorridorCutAcrossIsAPassageADoorIsNot) {
 }
 
 TEST(Places, TheCommandsStepJoinsOneGroupPerPassageItReportsAndNothingWhenOff) {
-  // (Cli.PassagesJoinACorridorsGroups: a real corridor cut across is joined.)
-  const sim::Building building = sim::makeBuilding("office");
+  // The simulated building with a loop: one of its corridor's cuts is a
+  // contact of 2 m or less, and joined. (A real corridor cut across, the shipped office log's, is joined in
+  // Cli.PassagesJoinACorridorsGroupsAndOffKeepsThem and, through this
+  // function, in the Python module's test_grouping.)
+  const sim::Building building = sim::makeBuilding("loop");
   const std::vector<Observation<pcl::PointXYZ>> observations =
       test::simulate<pcl::PointXYZ>(building.plan, building.route, sim::laser360());
   ObservationGrouping<pcl::PointXYZ> grouping;
@@ -574,6 +577,7 @@ TEST(Places, TheCommandsStepJoinsOneGroupPerPassageItReportsAndNothingWhenOff) {
   const Partition before = grouping.compute();
   Partition after = before;
   const std::vector<Door> joined = joinGroupsThroughPassages(observations, grouping.getParameters(), after);
+  EXPECT_FALSE(joined.empty());
   EXPECT_EQ(after.groups.size() + joined.size(), before.groups.size());
   for (const Door& passage : joined)
     EXPECT_EQ(after.group_of[std::size_t(before.groups[std::size_t(passage.place_a)][0])],
