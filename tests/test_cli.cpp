@@ -1083,8 +1083,8 @@ TEST_F(Cli, PassagesJoinACorridorsGroupsAndOffKeepsThem) {
   // The place ids stay the group indices, and no door of the places lies between one place.
   EXPECT_EQ(on.at("place_ids").size(), on.at("groups").size());
   for (std::size_t g = 0; g < on.at("place_ids").size(); ++g) EXPECT_EQ(on.at("place_ids")[g], int(g));
-  for (const auto& door : readJson(dir_ / "on" / "places.json").at("doors"))
-    EXPECT_NE(door.at("places")[0], door.at("places")[1]);
+  const nlohmann::json places = readJson(dir_ / "on" / "places.json");
+  for (const auto& door : places.at("doors")) EXPECT_NE(door.at("places")[0], door.at("places")[1]);
 }
 
 TEST_F(Cli, PosesAtUtmCoordinatesAreWrittenAtFullPrecision) {
