@@ -29,9 +29,9 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
-#include <numeric>
 #include <string>
 #include <vector>
 

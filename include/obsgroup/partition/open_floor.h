@@ -73,6 +73,14 @@ constexpr double kSeenBeyondViews = 4.0 / 3.0;
 /// "Open floor").
 constexpr double kClutterExtent = 1.0;
 
+/// Joins the groups of `partition` named in `pairs` (indices of its groups),
+/// and through them the groups joined to those. The groups stay ascending
+/// and ordered by their first observation; the split tree and warnings are
+/// kept. Returns, for each group of the result, the index (before the join)
+/// of the first of the groups it holds. Throws std::invalid_argument on an
+/// index out of range.
+std::vector<int> joinGroups(Partition& partition, const std::vector<std::pair<int, int>>& pairs);
+
 /// Joins the groups of `partition` between which every step of the route
 /// has a narrowest chord (narrowestChord, sides capped at `width`, pieces
 /// within kClutterExtent free) of at least `width` metres and is enclosed
@@ -85,14 +93,6 @@ constexpr double kClutterExtent = 1.0;
 /// joins made, in the order of their pairs of groups. Throws
 /// std::invalid_argument when positions are not one per observation, or
 /// width, cell, view_range or reach is not finite and positive.
-/// Joins the groups of `partition` named in `pairs` (indices of its groups),
-/// and through them the groups joined to those. The groups stay ascending
-/// and ordered by their first observation; the split tree and warnings are
-/// kept. Returns, for each group of the result, the index (before the join)
-/// of the first of the groups it holds. Throws std::invalid_argument on an
-/// index out of range.
-std::vector<int> joinGroups(Partition& partition, const std::vector<std::pair<int, int>>& pairs);
-
 std::vector<OpenFloorJoin> joinAcrossOpenFloor(Partition& partition, const std::vector<Eigen::Vector2d>& positions,
                                                double width, double cell, const OccupiedAt& occupied,
                                                double view_range, double reach = kOpenFloorReach);
